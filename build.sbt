@@ -1,0 +1,35 @@
+// Chisel generator for the all-pairs AABB broad-phase accelerator.
+// Sources live in src/ and tests in test/ (not sbt's default layout) so the
+// repository's top level reads as src/, test/, host/, scripts/.
+ThisBuild / scalaVersion := "2.13.14"
+ThisBuild / version      := "0.1.0"
+
+val chiselVersion = "6.6.0"
+
+lazy val root = (project in file("."))
+  .settings(
+    name := "bpaccel",
+    libraryDependencies ++= Seq(
+      "org.chipsalliance" %% "chisel"     % chiselVersion,
+      "com.github.scopt"  %% "scopt"      % "4.1.0",
+      "edu.berkeley.cs"   %% "chiseltest" % "6.0.0" % Test
+    ),
+    addCompilerPlugin("org.chipsalliance" % "chisel-plugin" % chiselVersion cross CrossVersion.full),
+    scalacOptions ++= Seq(
+      "-language:reflectiveCalls",
+      "-deprecation",
+      "-feature",
+      "-Xcheckinit",
+      "-Ymacro-annotations"
+    ),
+    Compile / scalaSource := baseDirectory.value / "src",
+    Test / scalaSource    := baseDirectory.value / "test",
+    // Simulations are CPU-bound; the machine has two cores.
+    Test / parallelExecution := true,
+    Test / testForkedParallel := true,
+    concurrentRestrictions in Global += Tags.limit(Tags.Test, 2),
+    Test / fork := true,
+    Test / javaOptions ++= Seq("-Xmx6g", "-Xss16m"),
+    Compile / run / fork := true,
+    Compile / run / javaOptions ++= Seq("-Xmx6g", "-Xss16m")
+  )

@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# Installs what a fresh machine lacks; quick and silent when all is present.
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+
+debian_packages=(
+  default-jdk-headless maven           # sbt runs on the JDK; Maven fetches the sbt launcher
+  verilator g++ cmake ninja-build make pkg-config
+  libbullet-dev googletest libgtest-dev nlohmann-json3-dev libcli11-dev libfmt-dev
+  python3-venv python3-matplotlib
+)
+
+missing=()
+for pkg in "${debian_packages[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null || true)
+  [ "$status" = "install ok installed" ] || missing+=("$pkg")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "deps: installing Debian packages: ${missing[*]}" >&2
+  sudo_cmd=()
+  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+fi
+
+# The sbt launcher (scripts/sbt fetches it too; doing it here keeps `make deps` the one install step).
+"$here/sbt" --fetch-launcher
