@@ -1,0 +1,73 @@
+package bpaccel
+
+import java.nio.file.{Files, Path, Paths}
+
+import chisel3.stage.ChiselGeneratorAnnotation
+import circt.stage.{ChiselStage, FirtoolOption}
+
+/** Emits the SystemVerilog of one configuration plus its C header.
+  *
+  * Usage: EmitVerilog --m 16 --capacity 4096 --target-dir generated/m16
+  */
+object EmitVerilog {
+  /** Raw command-line values; turned into [[AccelParams]] (and checked) once all are read. */
+  private case class Options(
+    m: Int = AccelParams().m,
+    capacity: Option[Int] = None,
+    keyWidth: Int = AccelParams().keyWidth,
+    queueDepth: Int = AccelParams().resultQueueDepth,
+    outputReg: Boolean = AccelParams().bufferOutputReg,
+    debugPort: Boolean = false,
+    targetDir: Path = Paths.get("generated")
+  ) {
+    def params: AccelParams =
+      AccelParams(m, capacity.getOrElse(AccelParams.defaultCapacity(m)), keyWidth, queueDepth, outputReg, debugPort)
+  }
+
+  /** firtool options that keep the output plain enough for Yosys, Verilator and vendor tools. */
+  val firtoolOptions: Array[String] = Array(
+    "-disable-all-randomization",
+    "-strip-debug-info",
+    "--lowering-options=disallowLocalVariables,disallowPackedArrays,locationInfoStyle=none"
+  )
+
+  def emit(p: AccelParams, targetDir: Path): Path = {
+    Files.createDirectories(targetDir)
+    // One file per module (what lint and FPGA flows expect) plus filelist.f.
+    (new ChiselStage).execute(
+      Array("--target", "systemverilog", "--split-verilog", "--target-dir", targetDir.toString),
+      Seq(ChiselGeneratorAnnotation(() => new BroadPhaseAccel(p))) ++ firtoolOptions.map(FirtoolOption(_))
+    )
+    Files.writeString(targetDir.resolve("bpaccel_params.h"), CHeader(p))
+    targetDir.resolve("filelist.f")
+  }
+
+  def main(args: Array[String]): Unit = {
+    val parser = new scopt.OptionParser[Options]("EmitVerilog") {
+      head("Emits the broad-phase accelerator's SystemVerilog and C header")
+      opt[Int]("m").action((v, o) => o.copy(m = v)).text("parallelism: pair tests per cycle")
+      opt[Int]("capacity")
+        .action((v, o) => o.copy(capacity = Some(v)))
+        .text(s"objects per run, a multiple of m (default ${AccelParams.defaultRows} * m)")
+      opt[Int]("key-width").action((v, o) => o.copy(keyWidth = v)).text("bits per coordinate key")
+      opt[Int]("queue-depth").action((v, o) => o.copy(queueDepth = v)).text("result queue beats")
+      opt[Boolean]("output-reg").action((v, o) => o.copy(outputReg = v)).text("register the memory outputs")
+      opt[Boolean]("debug-port").action((v, o) => o.copy(debugPort = v)).text("add the per-lane debug probe")
+      opt[String]("target-dir").action((v, o) => o.copy(targetDir = Paths.get(v))).text("output folder")
+    }
+    // Parameters are validated when the case class is built; report that as a usage error.
+    parser.parse(args, Options()) match {
+      case Some(o) =>
+        val params =
+          try o.params
+          catch {
+            case e: IllegalArgumentException =>
+              System.err.println(s"EmitVerilog: invalid parameters: ${e.getMessage.stripPrefix("requirement failed: ")}")
+              sys.exit(2)
+          }
+        val out = emit(params, o.targetDir)
+        println(s"wrote $out and ${o.targetDir.resolve("bpaccel_params.h")} for $params")
+      case None => sys.exit(2)
+    }
+  }
+}
