@@ -1,0 +1,96 @@
+package bpaccel
+
+import chisel3._
+import chiseltest._
+import org.scalatest.Assertions.fail
+
+/** What one run returned, as the consumer saw it. */
+case class RunOutcome(
+  pairs: Seq[(Int, Int)],                     // every pair of every beat, in arrival order
+  probeCycles: Vector[Vector[Option[(Int, Int)]]], // per scheduled cycle, per lane (debug port only)
+  error: Int,
+  cycles: Long,
+  issueCycles: Long,
+  stallCycles: Long,
+  hits: Long
+)
+
+/** Drives a [[BroadPhaseAccel]] through its ports, one clock at a time. */
+class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
+  private val p = dut.p
+  dut.clock.setTimeout(0)
+
+  def idleInputs(): Unit = {
+    dut.io.load.valid.poke(false.B)
+    dut.io.start.valid.poke(false.B)
+    dut.io.result.ready.poke(false.B)
+  }
+
+  def load(boxes: Seq[Box]): Unit = {
+    for (b <- boxes) {
+      dut.io.load.valid.poke(true.B)
+      for (a <- 0 until 3) {
+        dut.io.load.bits.min(a).poke(b.min(a).U(p.keyWidth.W))
+        dut.io.load.bits.max(a).poke(b.max(a).U(p.keyWidth.W))
+      }
+      var waited = 0
+      while (!dut.io.load.ready.peek().litToBoolean) {
+        dut.clock.step(); waited += 1
+        if (waited > 100) fail("load.ready stayed low for 100 cycles while idle")
+      }
+      dut.clock.step()
+    }
+    dut.io.load.valid.poke(false.B)
+  }
+
+  /** Sends start(n) and plays the consumer until done, with `ready(cycle)` as its pattern. */
+  def start(n: Int, ready: Int => Boolean = _ => true): RunOutcome = {
+    dut.io.start.valid.poke(true.B)
+    dut.io.start.bits.poke(n.U)
+    if (!dut.io.start.ready.peek().litToBoolean) fail("start.ready is low while the accelerator is idle")
+    dut.clock.step()
+    dut.io.start.valid.poke(false.B)
+
+    val pairs  = Seq.newBuilder[(Int, Int)]
+    val probes = Vector.newBuilder[Vector[Option[(Int, Int)]]]
+    var cycle  = 0
+    while (dut.io.status.busy.peek().litToBoolean) {
+      if (cycle >= maxCyclesPerRun) fail(s"run of n=$n did not finish within $maxCyclesPerRun cycles")
+      val r = ready(cycle)
+      dut.io.result.ready.poke(r.B)
+      if (r && dut.io.result.valid.peek().litToBoolean) {
+        val i0   = dut.io.result.bits.iBase.peek().litValue.toInt
+        val j0   = dut.io.result.bits.jBase.peek().litValue.toInt
+        val mask = dut.io.result.bits.mask.peek().litValue
+        for (k <- 0 until p.m if mask.testBit(k)) pairs += ((i0 + k, j0 + k))
+      }
+      dut.io.debug.foreach { d =>
+        if (d.cycleValid.peek().litToBoolean)
+          probes += Vector.tabulate(p.m) { k =>
+            val lane = d.lanes(k)
+            if (lane.valid.peek().litToBoolean) Some((lane.i.peek().litValue.toInt, lane.j.peek().litValue.toInt))
+            else None
+          }
+      }
+      dut.clock.step()
+      cycle += 1
+    }
+    dut.io.result.ready.poke(false.B)
+    if (!dut.io.status.done.peek().litToBoolean) fail("busy fell but done did not rise")
+    if (dut.io.result.valid.peek().litToBoolean) fail("a result beat is still waiting after done")
+    RunOutcome(
+      pairs.result(),
+      probes.result(),
+      dut.io.status.error.peek().litValue.toInt,
+      dut.io.counters.cycles.peek().litValue.toLong,
+      dut.io.counters.issueCycles.peek().litValue.toLong,
+      dut.io.counters.stallCycles.peek().litValue.toLong,
+      dut.io.counters.hits.peek().litValue.toLong
+    )
+  }
+
+  def run(boxes: Seq[Box], ready: Int => Boolean = _ => true): RunOutcome = {
+    load(boxes)
+    start(boxes.length, ready)
+  }
+}

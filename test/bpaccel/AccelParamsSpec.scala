@@ -1,0 +1,52 @@
+package bpaccel
+
+import org.scalatest.flatspec.AnyFlatSpec
+import org.scalatest.matchers.should.Matchers
+
+class AccelParamsSpec extends AnyFlatSpec with Matchers {
+  private def rejection(p: => AccelParams): String =
+    intercept[IllegalArgumentException](p).getMessage
+
+  "AccelParams" should "reject m = 0 with a message naming m" in {
+    rejection(AccelParams(m = 0, capacity = 8)) should include("m must be at least 1")
+  }
+
+  it should "reject a capacity that is not a multiple of m" in {
+    rejection(AccelParams(m = 3, capacity = 16)) should include("capacity must be a multiple of m")
+  }
+
+  it should "reject a capacity below two objects" in {
+    rejection(AccelParams(m = 1, capacity = 1)) should include("capacity must be at least 2")
+  }
+
+  it should "reject key widths outside 1..64" in {
+    rejection(AccelParams(keyWidth = 0)) should include("keyWidth")
+    rejection(AccelParams(keyWidth = 65)) should include("keyWidth")
+  }
+
+  it should "reject a result queue too shallow to keep the pipeline streaming" in {
+    rejection(AccelParams(resultQueueDepth = 2)) should include("resultQueueDepth")
+  }
+
+  it should "size indices and counts for the capacity" in {
+    val p = AccelParams(m = 3, capacity = 24)
+    p.indexWidth shouldBe 5 // 0..23
+    p.countWidth shouldBe 5 // 0..24
+    p.depth shouldBe 8
+    AccelParams(m = 4, capacity = 32).countWidth shouldBe 6 // 32 needs six bits
+  }
+
+  it should "default to 256 rows per memory for any m" in {
+    AccelParams.defaultCapacity(13) shouldBe 13 * 256
+    AccelParams().capacity shouldBe AccelParams.defaultCapacity(AccelParams().m)
+  }
+
+  "The C header" should "carry the parameters the host must agree with" in {
+    val h = CHeader(AccelParams(m = 5, capacity = 40))
+    h should include("#define BPACCEL_M 5")
+    h should include("#define BPACCEL_CAPACITY 40")
+    h should include("#define BPACCEL_KEY_WIDTH 32")
+    h should include(s"#define BPACCEL_RUN_OVERHEAD_CYCLES ${AccelParams(m = 5, capacity = 40).runOverheadCycles}")
+    h should include("#define BPACCEL_ERROR_LOAD_OVERFLOW 3")
+  }
+}

@@ -1,0 +1,31 @@
+package bpaccel
+
+import org.scalatest.matchers.should.Matchers
+
+/** Assertions shared by the hardware specs: what every run must satisfy. */
+trait Checks extends Matchers {
+
+  /** Pairs, counters and cycle accounting of one run against the reference. */
+  def checkRun(p: AccelParams, boxes: Seq[Box], out: RunOutcome, consumerNeverStalls: Boolean): Unit = {
+    val n = boxes.length
+    out.error shouldBe AccelError.None
+    out.pairs.foreach { case (i, j) =>
+      withClue(s"pair ($i, $j): ") { i should be < j; j should be < n }
+    }
+    out.pairs.distinct.length shouldBe out.pairs.length // nothing reported twice
+    out.pairs.toSet shouldBe Box.bruteForcePairs(boxes) // nothing missed, nothing extra
+    out.hits shouldBe out.pairs.length.toLong
+    out.issueCycles shouldBe Schedule.issueCycles(n, p.m)
+    val overhead = if (n < 2) 0 else p.runOverheadCycles
+    out.cycles shouldBe out.issueCycles + out.stallCycles + overhead
+    if (consumerNeverStalls) out.stallCycles shouldBe 0
+  }
+
+  /** The hardware's per-lane probes against the golden model, cycle by cycle. */
+  def checkSchedule(p: AccelParams, n: Int, out: RunOutcome): Unit = {
+    val golden = SeedScheduleModel.cycles(n, p.m)
+    out.probeCycles.length shouldBe golden.length
+    for (((hw, gm), c) <- out.probeCycles.zip(golden).zipWithIndex)
+      withClue(s"m=${p.m} n=$n cycle $c: ") { hw shouldBe gm }
+  }
+}

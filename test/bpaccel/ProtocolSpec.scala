@@ -1,0 +1,104 @@
+package bpaccel
+
+import chisel3._
+import chiseltest._
+import org.scalatest.flatspec.AnyFlatSpec
+
+import scala.util.Random
+
+/** Errors instead of silent truncation, and recovery after runs and resets. */
+class ProtocolSpec extends AnyFlatSpec with Simulators with Checks {
+  private val p = AccelParams(m = 4, capacity = 16)
+
+  private def withDut(body: (BroadPhaseAccel, AccelDriver) => Unit): Unit =
+    onVerilator(p) { dut =>
+      val drv = new AccelDriver(dut)
+      drv.idleInputs()
+      body(dut, drv)
+    }
+
+  private def boxes(n: Int, seed: Int) = Box.Scenes.uniform(new Random(seed), n, p.keyWidth, 30, 10)
+
+  "A load beyond the capacity" should "raise LoadOverflow at once and fail the next start without results" in {
+    withDut { (dut, drv) =>
+      drv.load(boxes(p.capacity, 1))
+      dut.io.status.error.expect(AccelError.None.U)
+      dut.io.status.loaded.expect(p.capacity.U)
+      drv.load(boxes(1, 2))
+      dut.io.status.error.expect(AccelError.LoadOverflow.U)
+      val out = drv.start(p.capacity)
+      out.error shouldBe AccelError.LoadOverflow
+      out.pairs shouldBe empty
+      out.cycles shouldBe 0
+      // The error does not stick: a correct run follows.
+      val b = boxes(9, 3)
+      checkRun(p, b, drv.run(b), consumerNeverStalls = true)
+    }
+  }
+
+  "A start with n above the capacity" should "fail with CountOverCapacity" in {
+    withDut { (_, drv) =>
+      drv.load(boxes(p.capacity, 4))
+      val out = drv.start(p.capacity + 1)
+      out.error shouldBe AccelError.CountOverCapacity
+      out.pairs shouldBe empty
+    }
+  }
+
+  "A start with n above the boxes loaded" should "fail with CountOverLoaded" in {
+    withDut { (_, drv) =>
+      drv.load(boxes(5, 5))
+      val out = drv.start(6)
+      out.error shouldBe AccelError.CountOverLoaded
+      out.pairs shouldBe empty
+      out.hits shouldBe 0
+    }
+  }
+
+  "Runs with fewer than two objects" should "finish at once with no pairs and no error" in {
+    withDut { (_, drv) =>
+      for (n <- Seq(0, 1)) {
+        val out = drv.run(boxes(n, 6))
+        out.error shouldBe AccelError.None
+        out.pairs shouldBe empty
+        out.cycles shouldBe 0
+      }
+    }
+  }
+
+  "Loading" should "be refused while a run is busy" in {
+    withDut { (dut, drv) =>
+      drv.load(boxes(16, 7))
+      dut.io.start.valid.poke(true.B)
+      dut.io.start.bits.poke(16.U)
+      dut.clock.step()
+      dut.io.start.valid.poke(false.B)
+      dut.io.status.busy.expect(true.B)
+      dut.io.load.ready.expect(false.B)
+      dut.io.start.ready.expect(false.B)
+    }
+  }
+
+  "A reset in the middle of a run" should "leave an idle accelerator that runs the next scene exactly" in {
+    withDut { (dut, drv) =>
+      drv.load(boxes(16, 8))
+      dut.io.start.valid.poke(true.B)
+      dut.io.start.bits.poke(16.U)
+      dut.clock.step()
+      dut.io.start.valid.poke(false.B)
+      dut.io.result.ready.poke(true.B)
+      dut.clock.step(7)
+      dut.io.status.busy.expect(true.B)
+      dut.reset.poke(true.B)
+      dut.clock.step()
+      dut.reset.poke(false.B)
+      dut.io.result.ready.poke(false.B)
+      dut.io.status.busy.expect(false.B)
+      dut.io.status.done.expect(false.B)
+      dut.io.status.loaded.expect(0.U)
+      dut.io.result.valid.expect(false.B)
+      val b = boxes(13, 9)
+      checkRun(p, b, drv.run(b, c => c % 3 != 0), consumerNeverStalls = false)
+    }
+  }
+}

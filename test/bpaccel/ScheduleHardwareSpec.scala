@@ -1,0 +1,44 @@
+package bpaccel
+
+import chiseltest._
+import org.scalatest.flatspec.AnyFlatSpec
+
+import scala.util.Random
+
+/** The generated sequencer, rotator and pipeline against the seed's golden
+  * schedule, cycle by cycle and lane by lane, on the Scala simulator.
+  */
+class ScheduleHardwareSpec extends AnyFlatSpec with Simulators with Checks {
+
+  private def scheduleAllCounts(m: Int, counts: Int => Seq[Int], capacity: Int): Unit = {
+    val p = AccelParams(m = m, capacity = capacity, debugPort = true)
+    onVerilator(p) { dut =>
+      val drv = new AccelDriver(dut)
+      drv.idleInputs()
+      val rng = new Random(m)
+      // One simulator for many runs: each run also proves a new run after a finished one works.
+      for (n <- counts(capacity)) withClue(s"m=$m n=$n: ") {
+        val boxes = Box.Scenes.uniform(rng, n, p.keyWidth, span = 60, maxExtent = 12)
+        val out   = drv.run(boxes)
+        checkSchedule(p, n, out)
+        checkRun(p, boxes, out, consumerNeverStalls = true)
+      }
+    }
+  }
+
+  behavior of "The hardware schedule"
+
+  for (m <- 1 to 8)
+    it should s"match the golden model for m=$m and every n up to the capacity" in {
+      scheduleAllCounts(m, capacity => 0 to capacity, capacity = 5 * m)
+    }
+
+  for (m <- Seq(13, 16, 32))
+    it should s"match the golden model for m=$m at small n, around multiples of m and at the capacity" in {
+      scheduleAllCounts(
+        m,
+        capacity => (Seq(0, 1, 2, 3, m - 1, m, m + 1, 2 * m - 1, 2 * m, 2 * m + 1, capacity - 1, capacity)).distinct,
+        capacity = 3 * m
+      )
+    }
+}
