@@ -27,6 +27,7 @@ case class AccelParams(
     s"capacity must be a multiple of m so the objects stripe evenly: capacity = $capacity, m = $m"
   )
   require(keyWidth >= 1 && keyWidth <= 64, s"keyWidth must lie in 1..64, got keyWidth = $keyWidth")
+  require(m < (1 << 16) && capacity.toLong < (1L << 32), s"m must fit 16 bits and capacity 32 bits, got m = $m, capacity = $capacity")
 
   /** Rows of each of the m memories of a coordinate buffer. */
   val depth: Int = capacity / m

@@ -28,6 +28,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
     val result   = Decoupled(new ResultBeat(p))
     val status   = Output(new AccelStatus(p))
     val counters = Output(new AccelCounters(p))
+    val info     = Output(new AccelInfo)
     val debug    = if (p.debugPort) Some(Output(new DebugProbe(p))) else None
   })
 
@@ -202,6 +203,11 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   io.status.done   := done
   io.status.error  := error
   io.status.loaded := loaded
+
+  io.info.m                 := p.m.U
+  io.info.capacity          := p.capacity.U
+  io.info.keyWidth          := p.keyWidth.U
+  io.info.runOverheadCycles := p.runOverheadCycles.U
 
   io.counters.cycles      := cycles
   io.counters.issueCycles := issueCycles

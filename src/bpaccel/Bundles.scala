@@ -60,3 +60,13 @@ class DebugProbe(p: AccelParams) extends Bundle {
   val cycleValid = Bool() // this cycle carries a scheduled comparison
   val lanes      = Vec(p.m, new LaneProbe(p))
 }
+
+/** The configuration as constant outputs, so a host can check that the model
+  * it drives is the one its header describes.
+  */
+class AccelInfo extends Bundle {
+  val m                 = UInt(16.W)
+  val capacity          = UInt(32.W)
+  val keyWidth          = UInt(8.W)
+  val runOverheadCycles = UInt(8.W)
+}

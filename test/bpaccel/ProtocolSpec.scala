@@ -19,6 +19,15 @@ class ProtocolSpec extends AnyFlatSpec with Simulators with Checks {
 
   private def boxes(n: Int, seed: Int) = Box.Scenes.uniform(new Random(seed), n, p.keyWidth, 30, 10)
 
+  "The info port" should "report the configuration the C header describes" in {
+    withDut { (dut, _) =>
+      dut.io.info.m.expect(p.m.U)
+      dut.io.info.capacity.expect(p.capacity.U)
+      dut.io.info.keyWidth.expect(p.keyWidth.U)
+      dut.io.info.runOverheadCycles.expect(p.runOverheadCycles.U)
+    }
+  }
+
   "A load beyond the capacity" should "raise LoadOverflow at once and fail the next start without results" in {
     withDut { (dut, drv) =>
       drv.load(boxes(p.capacity, 1))

@@ -12,7 +12,7 @@ import scala.sys.process._
 class VerilogEmissionSpec extends AnyFlatSpec with Matchers {
 
   private def emitted(m: Int): (AccelParams, Path) = {
-    val p   = AccelParams(m = m)
+    val p   = AccelParams(m = m, capacity = AccelParams.defaultCapacity(m))
     val dir = Files.createTempDirectory(s"bpaccel-m$m-")
     EmitVerilog.emit(p, dir)
     (p, dir)
