@@ -10,7 +10,12 @@ CAPACITY  ?= $(shell echo $$((256 * $(M))))
 KEY_WIDTH ?= 32
 VERILOG_DIR ?= generated/m$(M)
 
-.PHONY: all deps test test-hw verilog lint clean
+# The host is built for one configuration: M and CAPACITY above.
+HOST_VERILOG := build/verilog/m$(M)-c$(CAPACITY)
+HOST_BUILD   := build/host-m$(M)-c$(CAPACITY)
+SCALA_SOURCES := $(wildcard src/bpaccel/*.scala) build.sbt
+
+.PHONY: all deps test test-hw test-host host verilog clean
 
 all: test
 
@@ -18,12 +23,23 @@ deps:
 	@./scripts/deps.sh
 
 # Every test of the project.
-test: deps test-hw
+test: deps test-hw test-host
 
 # The Chisel generator: golden model, ChiselTest (Scala simulator and Verilator),
 # Verilog lint and memory structure.
 test-hw: deps
 	$(SBT) test
+
+# The C++ host (build/bin/bpaccel) with the Verilated accelerator, and its tests.
+$(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
+	$(SBT) "runMain bpaccel.EmitVerilog --m $(M) --capacity $(CAPACITY) --key-width 32 --target-dir $(HOST_VERILOG)"
+
+host: deps $(HOST_VERILOG)/filelist.f
+	cmake -S host -B $(HOST_BUILD) -G Ninja -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG))
+	cmake --build $(HOST_BUILD) -j 2
+
+test-host: host
+	ctest --test-dir $(HOST_BUILD) --output-on-failure -j 2
 
 # SystemVerilog (one file per module, filelist.f) and bpaccel_params.h for one configuration.
 verilog: deps

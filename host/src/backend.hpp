@@ -1,0 +1,61 @@
+#pragma once
+// The broad-phase backend interface: all-pairs over one batch of boxes.
+
+#include <cstddef>
+#include <limits>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "types.hpp"
+
+namespace bpaccel {
+
+/// Loads up to capacity() boxes, runs, and returns every overlapping pair
+/// (indices into the batch, i < j) with the run's statistics.
+class Backend {
+ public:
+  virtual ~Backend() = default;
+  virtual std::string name() const = 0;
+  /// Most boxes one run takes; larger sets are chunked by BroadPhase.
+  virtual std::size_t capacity() const = 0;
+  /// Appends the overlapping pairs of `boxes` to `out` and adds to `stats`.
+  virtual void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) = 0;
+};
+
+/// The accelerator's schedule in closed form: issue cycles of one run of n
+/// objects with m lanes, sum over blocks b of (n - 1 - b*m); 0 for n < 2.
+/// Must equal bpaccel.Schedule.issueCycles in the generator (tests compare
+/// it with the Verilated hardware's own counter).
+std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m);
+
+/// Fast C++ model of the accelerator: the same schedule, pairs and cycle
+/// count as the RTL with a consumer that never stalls, for any n up to its
+/// capacity and at software speed.
+class ModelBackend final : public Backend {
+ public:
+  ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles);
+  std::string name() const override { return "model"; }
+  std::size_t capacity() const override { return capacity_; }
+  void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
+
+ private:
+  std::size_t m_;
+  std::size_t capacity_;
+  std::uint64_t overhead_;
+};
+
+/// Software alone: a plain all-pairs test with no capacity limit.
+class CpuBackend final : public Backend {
+ public:
+  std::string name() const override { return "cpu"; }
+  std::size_t capacity() const override { return std::numeric_limits<std::size_t>::max(); }
+  void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
+
+ private:
+  // Structure-of-arrays copy of the batch, reused across calls.
+  std::vector<std::uint32_t> soa_[6];
+};
+
+}  // namespace bpaccel

@@ -1,0 +1,67 @@
+#include "box_file.hpp"
+
+#include <charconv>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "keys.hpp"
+
+namespace bpaccel {
+
+ParseError::ParseError(std::size_t line, const std::string& reason)
+    : std::runtime_error(fmt::format("line {}: {}", line, reason)), line_(line) {}
+
+namespace {
+
+bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+}  // namespace
+
+std::vector<Aabb> readBoxes(std::istream& in) {
+  std::vector<Aabb> boxes;
+  std::string text;
+  std::size_t lineNo = 0;
+  static constexpr const char* kField[6] = {"minx", "miny", "minz", "maxx", "maxy", "maxz"};
+  while (std::getline(in, text)) {
+    ++lineNo;
+    const auto hash = text.find('#');
+    if (hash != std::string::npos) text.resize(hash);
+    float v[6];
+    int fields = 0;
+    const char* p = text.data();
+    const char* end = p + text.size();
+    while (true) {
+      while (p < end && isSpace(*p)) ++p;
+      if (p == end) break;
+      const char* tokenEnd = p;
+      while (tokenEnd < end && !isSpace(*tokenEnd)) ++tokenEnd;
+      const std::string_view token(p, static_cast<std::size_t>(tokenEnd - p));
+      if (fields == 6) throw ParseError(lineNo, "more than 6 fields (expected minx miny minz maxx maxy maxz)");
+      float value = 0;
+      // from_chars takes no leading '+', which people write; allow one.
+      const char* digits = (*p == '+' && tokenEnd - p > 1 && p[1] != '-' && p[1] != '+') ? p + 1 : p;
+      const auto [ptr, ec] = std::from_chars(digits, tokenEnd, value);
+      if (ec == std::errc::result_out_of_range)
+        throw ParseError(lineNo, fmt::format("{} '{}' is out of float range", kField[fields], token));
+      if (ec != std::errc() || ptr != tokenEnd)
+        throw ParseError(lineNo, fmt::format("{} '{}' is not a number", kField[fields], token));
+      if (std::isnan(value)) throw ParseError(lineNo, fmt::format("{} is NaN", kField[fields]));
+      v[fields++] = value;
+      p = tokenEnd;
+    }
+    if (fields == 0) continue;
+    if (fields != 6)
+      throw ParseError(lineNo, fmt::format("{} fields, expected 6 (minx miny minz maxx maxy maxz)", fields));
+    Aabb box{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+    for (int a = 0; a < 3; ++a)
+      if (box.min[a] > box.max[a])
+        throw ParseError(lineNo, fmt::format("{} {} > {} {}", kField[a], box.min[a], kField[a + 3], box.max[a]));
+    if (boxes.size() == kMaxObjects) throw ParseError(lineNo, "too many boxes for 32-bit indices");
+    boxes.push_back(box);
+  }
+  if (in.bad()) throw ParseError(lineNo, "read error");
+  return boxes;
+}
+
+}  // namespace bpaccel

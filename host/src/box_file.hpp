@@ -1,0 +1,29 @@
+#pragma once
+// The text format of `bpaccel pairs --input`: one box a line.
+
+#include <istream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "types.hpp"
+
+namespace bpaccel {
+
+/// A malformed line: names the file line and the reason.
+class ParseError : public std::runtime_error {
+ public:
+  ParseError(std::size_t line, const std::string& reason);
+  std::size_t line() const { return line_; }
+
+ private:
+  std::size_t line_;
+};
+
+/// Reads `minx miny minz maxx maxy maxz` lines; blank lines and `#` comments
+/// are skipped. Any malformed line (field count, not a number, NaN,
+/// min > max) throws ParseError with its 1-based line number; nothing is
+/// returned partially.
+std::vector<Aabb> readBoxes(std::istream& in);
+
+}  // namespace bpaccel

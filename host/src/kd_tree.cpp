@@ -1,0 +1,91 @@
+#include "kd_tree.hpp"
+
+#include <algorithm>
+
+namespace bpaccel {
+
+void KdTree::build(std::span<const KeyBox> boxes, std::size_t cellSize) {
+  pool_.clear();
+  leaves_.clear();
+  stack_.clear();
+  const auto n = static_cast<std::uint32_t>(boxes.size());
+  pool_.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) pool_[i] = i;
+  constexpr std::uint64_t kTop = std::uint64_t{1} << 32;
+  stack_.push_back({0, n, {0, 0, 0}, {kTop, kTop, kTop}});
+  while (!stack_.empty()) {
+    const Task task = stack_.back();
+    stack_.pop_back();
+    if (task.count <= cellSize || !split(boxes, task))
+      leaves_.push_back({task.begin, task.count, task.lo, task.hi});
+  }
+}
+
+// Tries the axes from widest spread of box centres down; splits at the
+// median centre. A split must shrink both children and may duplicate at most
+// a quarter of the boxes, which bounds the tree's size to O(n) per level.
+bool KdTree::split(std::span<const KeyBox> boxes, const Task& task) {
+  std::array<std::uint64_t, 3> spread{}, lowest{};
+  for (int a = 0; a < 3; ++a) {
+    std::uint64_t lo = UINT64_MAX, hi = 0;
+    for (std::uint32_t t = 0; t < task.count; ++t) {
+      const KeyBox& b = boxes[pool_[task.begin + t]];
+      const std::uint64_t c = std::uint64_t{b.min[a]} + b.max[a];  // twice the centre
+      lo = std::min(lo, c);
+      hi = std::max(hi, c);
+    }
+    spread[a] = hi - lo;
+    lowest[a] = lo;
+  }
+  std::array<int, 3> axes{0, 1, 2};
+  std::sort(axes.begin(), axes.end(), [&](int x, int y) { return spread[x] > spread[y]; });
+
+  for (int axis : axes) {
+    if (spread[axis] == 0) break;
+    centres_.resize(task.count);
+    for (std::uint32_t t = 0; t < task.count; ++t) {
+      const KeyBox& b = boxes[pool_[task.begin + t]];
+      centres_[t] = std::uint64_t{b.min[axis]} + b.max[axis];
+    }
+    auto mid = centres_.begin() + task.count / 2;
+    std::nth_element(centres_.begin(), mid, centres_.end());
+    // Plane in key space: ceil(median centre); strictly above the lowest centre so both sides get boxes.
+    std::uint64_t plane = std::max((*mid + 1) / 2, (lowest[axis] + 2) / 2);
+    plane = std::max(plane, task.lo[axis] + 1);
+    if (plane >= task.hi[axis]) continue;
+
+    std::uint32_t left = 0, right = 0;
+    for (std::uint32_t t = 0; t < task.count; ++t) {
+      const KeyBox& b = boxes[pool_[task.begin + t]];
+      left += b.min[axis] < plane;
+      right += b.max[axis] >= plane;
+    }
+    if (left >= task.count || right >= task.count || left + right > task.count + task.count / 4) continue;
+
+    // Append both children's item lists to the pool (resize first: the
+    // parent's list lives in the same vector).
+    const auto leftBegin = static_cast<std::uint32_t>(pool_.size());
+    pool_.resize(pool_.size() + left + right);
+    std::uint32_t* l = pool_.data() + leftBegin;
+    std::uint32_t* r = l + left;
+    for (std::uint32_t t = 0; t < task.count; ++t) {
+      const std::uint32_t id = pool_[task.begin + t];
+      const KeyBox& b = boxes[id];
+      if (b.min[axis] < plane) *l++ = id;
+      if (b.max[axis] >= plane) *r++ = id;
+    }
+    Task lower = task, upper = task;
+    lower.begin = leftBegin;
+    lower.count = left;
+    lower.hi[axis] = plane;
+    upper.begin = leftBegin + left;
+    upper.count = right;
+    upper.lo[axis] = plane;
+    stack_.push_back(upper);
+    stack_.push_back(lower);
+    return true;
+  }
+  return false;
+}
+
+}  // namespace bpaccel

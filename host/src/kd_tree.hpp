@@ -1,0 +1,59 @@
+#pragma once
+// A k-d tree over key boxes whose leaves (cells) the accelerator processes.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "types.hpp"
+
+namespace bpaccel {
+
+/// Built anew every frame; all storage is kept and reused between builds, and
+/// no node allocates. Cells partition key space into half-open boxes
+/// [lo, hi). A box goes to a child whose region it touches (so a box that
+/// straddles a split plane goes to both), which puts every box that contains
+/// a point p into the one leaf whose region contains p.
+class KdTree {
+ public:
+  struct Leaf {
+    std::uint32_t begin;               // first item in items()
+    std::uint32_t count;               // number of boxes in the cell
+    std::array<std::uint64_t, 3> lo;   // region, inclusive
+    std::array<std::uint64_t, 3> hi;   // region, exclusive (up to 2^32)
+    bool contains(const std::array<std::uint32_t, 3>& p) const {
+      return lo[0] <= p[0] && p[0] < hi[0] && lo[1] <= p[1] && p[1] < hi[1] && lo[2] <= p[2] && p[2] < hi[2];
+    }
+  };
+
+  /// Splits until a cell holds at most `cellSize` boxes, or until no split
+  /// helps (every plane is straddled by too many boxes): such a cell stays
+  /// larger than cellSize and is chunked by the caller.
+  void build(std::span<const KeyBox> boxes, std::size_t cellSize);
+
+  const std::vector<Leaf>& leaves() const { return leaves_; }
+  /// Box indices of a leaf.
+  std::span<const std::uint32_t> items(const Leaf& leaf) const { return {pool_.data() + leaf.begin, leaf.count}; }
+
+ private:
+  struct Task {
+    std::uint32_t begin, count;
+    std::array<std::uint64_t, 3> lo, hi;
+  };
+  bool split(std::span<const KeyBox> boxes, const Task& task);
+
+  std::vector<std::uint32_t> pool_;      // item lists of all nodes, appended as built
+  std::vector<std::uint64_t> centres_;   // scratch for the median
+  std::vector<Task> stack_;
+  std::vector<Leaf> leaves_;
+};
+
+/// The reference point of an overlapping pair: the low corner of the two
+/// boxes' intersection. It lies in both boxes, so exactly one leaf holds it,
+/// and that leaf holds both boxes: a pair is reported only there.
+inline std::array<std::uint32_t, 3> referencePoint(const KeyBox& a, const KeyBox& b) {
+  return {std::max(a.min[0], b.min[0]), std::max(a.min[1], b.min[1]), std::max(a.min[2], b.min[2])};
+}
+
+}  // namespace bpaccel

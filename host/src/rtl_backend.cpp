@@ -1,0 +1,145 @@
+#include "rtl_backend.hpp"
+
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "VBroadPhaseAccel.h"
+#include "bpaccel_params.h"
+#include "verilated.h"
+
+namespace bpaccel {
+namespace {
+
+// Bit k of a result mask, whatever type Verilator chose for its width.
+template <typename T>
+bool maskBit(const T& mask, std::size_t k) {
+  if constexpr (std::is_integral_v<T>) {
+    return (static_cast<std::uint64_t>(mask) >> k) & 1u;
+  } else {
+    return (mask[k / 32] >> (k % 32)) & 1u;  // VlWide: 32-bit words
+  }
+}
+
+void setBox(VBroadPhaseAccel& top, const KeyBox& b) {
+  top.io_load_bits_min_0 = b.min[0];
+  top.io_load_bits_min_1 = b.min[1];
+  top.io_load_bits_min_2 = b.min[2];
+  top.io_load_bits_max_0 = b.max[0];
+  top.io_load_bits_max_1 = b.max[1];
+  top.io_load_bits_max_2 = b.max[2];
+}
+
+}  // namespace
+
+static_assert(BPACCEL_KEY_WIDTH == 32, "the host maps float32 to 32-bit keys");
+
+RtlBackend::RtlBackend(std::function<bool(std::uint64_t)> consumerReady)
+    : context_(std::make_unique<VerilatedContext>()),
+      top_(std::make_unique<VBroadPhaseAccel>(context_.get(), "accel")),
+      consumerReady_(consumerReady ? std::move(consumerReady) : [](std::uint64_t) { return true; }) {
+  reset();
+  // The header and the Verilated model must describe the same hardware.
+  const auto check = [](const char* what, std::uint64_t model, std::uint64_t header) {
+    if (model != header)
+      throw std::runtime_error(
+          fmt::format("rtl: Verilated model has {} = {} but bpaccel_params.h says {}; rebuild the host", what, model,
+                      header));
+  };
+  check("m", top_->io_info_m, BPACCEL_M);
+  check("capacity", top_->io_info_capacity, BPACCEL_CAPACITY);
+  check("key width", top_->io_info_keyWidth, BPACCEL_KEY_WIDTH);
+  check("run overhead cycles", top_->io_info_runOverheadCycles, BPACCEL_RUN_OVERHEAD_CYCLES);
+}
+
+RtlBackend::~RtlBackend() { top_->final(); }
+
+std::size_t RtlBackend::capacity() const { return BPACCEL_CAPACITY; }
+std::size_t RtlBackend::lanes() { return BPACCEL_M; }
+std::uint64_t RtlBackend::runOverheadCycles() { return BPACCEL_RUN_OVERHEAD_CYCLES; }
+
+void RtlBackend::settle() {
+  top_->clock = 0;
+  top_->eval();
+}
+
+void RtlBackend::tick() {
+  top_->clock = 0;
+  top_->eval();
+  top_->clock = 1;
+  top_->eval();
+}
+
+void RtlBackend::reset() {
+  top_->io_load_valid = 0;
+  top_->io_start_valid = 0;
+  top_->io_result_ready = 0;
+  top_->reset = 1;
+  tick();
+  tick();
+  top_->reset = 0;
+  settle();
+}
+
+void RtlBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) {
+  const std::size_t n = boxes.size();
+  if (n > capacity())
+    throw std::length_error(fmt::format("rtl: {} boxes exceed the hardware capacity {}", n, capacity()));
+  VBroadPhaseAccel& top = *top_;
+
+  for (const KeyBox& b : boxes) {
+    setBox(top, b);
+    top.io_load_valid = 1;
+    settle();
+    if (!top.io_load_ready) throw std::runtime_error("rtl: load port not ready while idle");
+    tick();
+  }
+  top.io_load_valid = 0;
+
+  top.io_start_valid = 1;
+  top.io_start_bits = static_cast<std::uint32_t>(n);
+  settle();
+  if (!top.io_start_ready) throw std::runtime_error("rtl: start not accepted while idle");
+  tick();
+  top.io_start_valid = 0;
+
+  // Play the consumer until the run is over. A bound far above any legal run
+  // turns a hang into an error.
+  const std::uint64_t issue = scheduleIssueCycles(n, BPACCEL_M);
+  const std::uint64_t limit = 64 * (issue + 1000);
+  const std::size_t before = out.size();
+  std::uint64_t beats = 0;
+  for (std::uint64_t cycle = 0;; ++cycle) {
+    if (cycle > limit) throw std::runtime_error(fmt::format("rtl: run of {} boxes did not finish", n));
+    const bool ready = consumerReady_(cycle);
+    top.io_result_ready = ready;
+    settle();
+    if (!top.io_status_busy) break;
+    if (ready && top.io_result_valid) {
+      const std::uint32_t i0 = top.io_result_bits_iBase;
+      const std::uint32_t j0 = top.io_result_bits_jBase;
+      for (std::size_t k = 0; k < BPACCEL_M; ++k)
+        if (maskBit(top.io_result_bits_mask, k))
+          out.emplace_back(i0 + static_cast<std::uint32_t>(k), j0 + static_cast<std::uint32_t>(k));
+      ++beats;
+    }
+    tick();
+  }
+  top.io_result_ready = 0;
+  settle();
+  if (!top.io_status_done) throw std::runtime_error("rtl: busy fell without done");
+  if (top.io_status_error != BPACCEL_ERROR_NONE)
+    throw std::runtime_error(fmt::format("rtl: hardware reported error code {}", top.io_status_error));
+  if (top.io_counters_hits != out.size() - before)
+    throw std::runtime_error(fmt::format("rtl: hardware counted {} hits but {} pairs arrived",
+                                         top.io_counters_hits, out.size() - before));
+  stats.runs += 1;
+  stats.cycles += top.io_counters_cycles;
+  stats.issueCycles += top.io_counters_issueCycles;
+  stats.stallCycles += top.io_counters_stallCycles;
+  stats.hits += top.io_counters_hits;
+  stats.boxesSent += n;
+  stats.beatsReceived += beats;
+}
+
+}  // namespace bpaccel

@@ -1,0 +1,45 @@
+#pragma once
+// The Verilated accelerator as a Backend.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+
+#include "backend.hpp"
+
+class VBroadPhaseAccel;
+class VerilatedContext;
+
+namespace bpaccel {
+
+/// Drives the generated hardware cycle by cycle through its load port, start
+/// command and result port, and reports the hardware's own counters. The
+/// configuration comes from bpaccel_params.h, and the constructor checks it
+/// against the model's info port.
+class RtlBackend final : public Backend {
+ public:
+  /// `consumerReady(cycle)` is the result consumer's ready pattern; by default
+  /// it is always ready, like a host that drains a FIFO at full rate.
+  explicit RtlBackend(std::function<bool(std::uint64_t)> consumerReady = {});
+  ~RtlBackend() override;
+  RtlBackend(const RtlBackend&) = delete;
+  RtlBackend& operator=(const RtlBackend&) = delete;
+
+  std::string name() const override { return "rtl"; }
+  std::size_t capacity() const override;
+  void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
+
+  static std::size_t lanes();
+  static std::uint64_t runOverheadCycles();
+
+ private:
+  void settle();  // evaluate combinational outputs for the current inputs
+  void tick();    // one rising clock edge
+  void reset();
+
+  std::unique_ptr<VerilatedContext> context_;
+  std::unique_ptr<VBroadPhaseAccel> top_;
+  std::function<bool(std::uint64_t)> consumerReady_;
+};
+
+}  // namespace bpaccel

@@ -1,0 +1,151 @@
+#include <gtest/gtest.h>
+
+#include <optional>
+#include <set>
+
+#include "backend.hpp"
+#include "broad_phase.hpp"
+#include "bpaccel_params.h"
+#include "keys.hpp"
+#include "scenes.hpp"
+
+using namespace bpaccel;
+using namespace bpaccel::testing;
+
+namespace {
+
+const std::vector<std::optional<std::size_t>> kCellSizes = {std::nullopt, 1, 2, 3, 5, 8, 16, 32, 64, 256};
+
+void expectExact(Backend& backend, const std::vector<Aabb>& boxes, std::optional<std::size_t> cell,
+                 const std::string& what) {
+  BroadPhase bp(backend, cell);
+  std::vector<Pair> pairs;
+  bp.findPairs(boxes, pairs);
+  const std::string label = what + " backend " + backend.name() + " cell " + (cell ? std::to_string(*cell) : "none");
+  // Exactly once: the sorted list equals the reference, which has no repeats.
+  EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << label;
+}
+
+}  // namespace
+
+TEST(BroadPhase, ModelAndCpuAreExactOnAdversarialScenesForEveryCellSize) {
+  ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+  CpuBackend cpu;
+  for (std::size_t n : {0u, 1u, 2u, 7u, 150u, 600u})
+    for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 11))
+      for (const auto& cell : kCellSizes) {
+        expectExact(model, boxes, cell, name + " n=" + std::to_string(n));
+        expectExact(cpu, boxes, cell, name + " n=" + std::to_string(n));
+      }
+}
+
+TEST(BroadPhase, CoversCellsAboveTheCapacityInChunksExactly) {
+  // A tiny capacity forces chunking of cells the tree cannot split and of whole scenes.
+  for (std::size_t capacity : {2u, 4u, 6u, 16u}) {
+    ModelBackend small(2, capacity, 5);
+    for (const auto& [name, boxes] : adversarialScenes(70, 5))
+      for (const auto& cell : {std::optional<std::size_t>{}, std::optional<std::size_t>{4},
+                               std::optional<std::size_t>{40}})
+        expectExact(small, boxes, cell, name + " capacity " + std::to_string(capacity));
+  }
+}
+
+TEST(BroadPhase, DegenerateScenesFallBackToChunkedLeaves) {
+  // All boxes identical: no plane splits them, so one leaf holds all 300.
+  std::vector<Aabb> same(300, box(1, 1, 1, 2, 2, 2));
+  ModelBackend small(4, 64, 5);
+  BroadPhase bp(small, 16);
+  std::vector<Pair> pairs;
+  bp.findPairs(same, pairs);
+  EXPECT_EQ(bp.tree().leaves().size(), 1u);
+  EXPECT_EQ(pairs.size(), 300u * 299u / 2u);
+  EXPECT_EQ(sorted(pairs), bruteForce(same));
+  EXPECT_GT(bp.stats().runs, 1u);  // chunked
+}
+
+TEST(KdTree, LeavesRespectTheCellSizeWhenSplitsExistAndPartitionSpace) {
+  // Small boxes spread thinly: planes rarely cut them, so every cell can split down.
+  std::mt19937 gen(3);
+  std::uniform_real_distribution<float> pos(-100, 100), ext(0, 0.5f);
+  std::vector<Aabb> boxes(2000);
+  for (auto& b : boxes) {
+    const float x = pos(gen), y = pos(gen), z = pos(gen);
+    b = box(x, y, z, x + ext(gen), y + ext(gen), z + ext(gen));
+  }
+  std::vector<KeyBox> keys;
+  toKeys(boxes, keys);
+  KdTree tree;
+  for (std::size_t cell : {8u, 32u, 128u}) {
+    tree.build(keys, cell);
+    std::size_t maxLeaf = 0, total = 0;
+    for (const auto& leaf : tree.leaves()) {
+      maxLeaf = std::max<std::size_t>(maxLeaf, leaf.count);
+      total += leaf.count;
+      // Every box of a leaf touches the leaf's region.
+      for (std::uint32_t id : tree.items(leaf))
+        for (int a = 0; a < 3; ++a) {
+          EXPECT_LT(keys[id].min[a], leaf.hi[a]);
+          EXPECT_GE(std::uint64_t{keys[id].max[a]}, leaf.lo[a]);
+        }
+    }
+    EXPECT_LE(maxLeaf, cell) << "uniform small boxes should always split down to the cell size";
+    EXPECT_LT(total, 2 * keys.size()) << "straddling boxes must not blow up the tree";
+    // Random points fall in exactly one leaf: the regions partition key space.
+    std::mt19937 rng(cell);
+    for (int t = 0; t < 2000; ++t) {
+      const std::array<std::uint32_t, 3> p{static_cast<std::uint32_t>(rng()), static_cast<std::uint32_t>(rng()),
+                                           static_cast<std::uint32_t>(rng())};
+      int holders = 0;
+      for (const auto& leaf : tree.leaves()) holders += leaf.contains(p);
+      EXPECT_EQ(holders, 1);
+    }
+  }
+}
+
+TEST(KdTree, ReportsAPairInSeveralLeavesOnlyOnce) {
+  // Two big overlapping boxes straddle every plane among many small ones, so
+  // they share many leaves; the reference-point rule must keep one copy.
+  std::vector<Aabb> boxes = adversarialScenes(400, 9).front().second;
+  boxes.push_back(box(-200, -200, -200, 200, 200, 200));
+  boxes.push_back(box(-150, -150, -150, 150, 150, 150));
+  CpuBackend cpu;
+  BroadPhase bp(cpu, 8);
+  std::vector<Pair> pairs;
+  bp.findPairs(boxes, pairs);
+  std::size_t sharing = 0;
+  for (const auto& leaf : bp.tree().leaves()) {
+    const auto items = bp.tree().items(leaf);
+    const bool a = std::find(items.begin(), items.end(), 400u) != items.end();
+    const bool b = std::find(items.begin(), items.end(), 401u) != items.end();
+    sharing += a && b;
+  }
+  EXPECT_GT(sharing, 1u) << "the test scene should put the big pair in several leaves";
+  EXPECT_EQ(std::count(pairs.begin(), pairs.end(), Pair{400, 401}), 1);
+  EXPECT_EQ(sorted(pairs), bruteForce(boxes));
+}
+
+TEST(BroadPhase, RejectsBadInputNamingTheObject) {
+  CpuBackend cpu;
+  BroadPhase bp(cpu, 16);
+  std::vector<Aabb> boxes = {box(0, 0, 0, 1, 1, 1), box(0, 0, 0, 1, 1, 1), box(3, 0, 0, 1, 1, 1)};
+  std::vector<Pair> pairs;
+  EXPECT_THROW(
+      {
+        try {
+          bp.findPairs(boxes, pairs);
+        } catch (const InputError& e) {
+          EXPECT_EQ(e.object(), 2u);
+          throw;
+        }
+      },
+      InputError);
+}
+
+TEST(ScheduleIssueCycles, MatchesThePlainSumOverBlocks) {
+  for (std::uint64_t m = 1; m <= 40; ++m)
+    for (std::uint64_t n = 0; n <= 300; ++n) {
+      std::uint64_t sum = 0;
+      for (std::uint64_t b = 0; n >= 2 && b * m <= n - 2; ++b) sum += n - 1 - b * m;
+      ASSERT_EQ(scheduleIssueCycles(n, m), sum) << "m=" << m << " n=" << n;
+    }
+}

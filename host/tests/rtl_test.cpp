@@ -1,0 +1,95 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "backend.hpp"
+#include "bpaccel_params.h"
+#include "broad_phase.hpp"
+#include "keys.hpp"
+#include "rtl_backend.hpp"
+#include "scenes.hpp"
+
+using namespace bpaccel;
+using namespace bpaccel::testing;
+
+namespace {
+
+std::vector<KeyBox> keysOf(const std::vector<Aabb>& boxes) {
+  std::vector<KeyBox> keys;
+  toKeys(boxes, keys);
+  return keys;
+}
+
+}  // namespace
+
+TEST(RtlBackend, AgreesWithTheModelOnPairsCyclesAndBeats) {
+  RtlBackend rtl;
+  ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+  std::mt19937 rng(42);
+  std::vector<std::size_t> sizes = {0, 1, 2, 3, BPACCEL_M - 1, BPACCEL_M, BPACCEL_M + 1, 2 * BPACCEL_M + 1,
+                                    BPACCEL_CAPACITY};
+  for (int t = 0; t < 12; ++t) sizes.push_back(rng() % 400);
+  for (std::size_t n : sizes)
+    for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n))) {
+      const auto keys = keysOf(boxes);
+      std::vector<Pair> fromRtl, fromModel;
+      RunStats rtlStats, modelStats;
+      rtl.run(keys, fromRtl, rtlStats);
+      model.run(keys, fromModel, modelStats);
+      const std::string label = name + " n=" + std::to_string(n);
+      EXPECT_EQ(fromRtl, fromModel) << label;  // same pairs, in the same order
+      EXPECT_EQ(sorted(fromRtl), bruteForce(boxes)) << label;
+      EXPECT_EQ(rtlStats.cycles, modelStats.cycles) << label;
+      EXPECT_EQ(rtlStats.beatsReceived, modelStats.beatsReceived) << label;
+      EXPECT_EQ(rtlStats.issueCycles, scheduleIssueCycles(n, BPACCEL_M)) << label;
+      EXPECT_EQ(rtlStats.cycles, n < 2 ? 0 : scheduleIssueCycles(n, BPACCEL_M) + BPACCEL_RUN_OVERHEAD_CYCLES)
+          << label;
+      EXPECT_EQ(rtlStats.stallCycles, 0u) << label;
+      if (n <= 400) break;  // the full-capacity case runs one scene only
+    }
+}
+
+TEST(RtlBackend, StallingConsumerLosesNoPairAndCountsTheStalls) {
+  std::mt19937 pattern(5);
+  RtlBackend rtl([&](std::uint64_t) { return pattern() % 4 == 0; });
+  ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+  for (const auto& [name, boxes] : adversarialScenes(300, 77)) {
+    const auto keys = keysOf(boxes);
+    std::vector<Pair> fromRtl, fromModel;
+    RunStats rtlStats, modelStats;
+    rtl.run(keys, fromRtl, rtlStats);
+    model.run(keys, fromModel, modelStats);
+    EXPECT_EQ(fromRtl, fromModel) << name;
+    EXPECT_EQ(rtlStats.cycles, rtlStats.issueCycles + rtlStats.stallCycles + BPACCEL_RUN_OVERHEAD_CYCLES) << name;
+    EXPECT_EQ(rtlStats.issueCycles, scheduleIssueCycles(300, BPACCEL_M)) << name;
+  }
+}
+
+TEST(RtlBackend, IsExactThroughTheKdTreeAndAcrossChunks) {
+  RtlBackend rtl;
+  for (const auto& [name, boxes] : adversarialScenes(500, 8))
+    for (std::optional<std::size_t> cell : {std::optional<std::size_t>{}, std::optional<std::size_t>{16}}) {
+      BroadPhase bp(rtl, cell);
+      std::vector<Pair> pairs;
+      bp.findPairs(boxes, pairs);
+      EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << name;
+    }
+  // More boxes than the hardware holds, all in one unsplittable cell.
+  std::vector<Aabb> many;
+  for (std::size_t i = 0; i < BPACCEL_CAPACITY + BPACCEL_CAPACITY / 3; ++i)
+    many.push_back(i % 7 == 0 ? box(0, 0, 0, 10, 10, 10) : box(1, 1, 1, 2, 2, 2));
+  BroadPhase bp(rtl, std::nullopt);
+  std::vector<Pair> pairs;
+  bp.findPairs(many, pairs);
+  EXPECT_EQ(pairs.size(), many.size() * (many.size() - 1) / 2);
+  EXPECT_EQ(sorted(pairs), bruteForce(many));
+  EXPECT_EQ(bp.stats().runs, 3u);  // three chunks of capacity/2: runs (0,1), (0,2), (1,2)
+}
+
+TEST(RtlBackend, RejectsABatchAboveTheCapacity) {
+  RtlBackend rtl;
+  std::vector<KeyBox> keys(BPACCEL_CAPACITY + 1, KeyBox{{0, 0, 0}, {1, 1, 1}});
+  std::vector<Pair> pairs;
+  RunStats stats;
+  EXPECT_THROW(rtl.run(keys, pairs, stats), std::length_error);
+}
