@@ -3,6 +3,7 @@
 //   bpaccel pairs --input FILE [--backend rtl|model|cpu] [--cell-size C|none] [--stats]
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -12,7 +13,11 @@
 #include <fmt/format.h>
 #include <fmt/ostream.h>
 
+#include <nlohmann/json.hpp>
+
 #include "backend.hpp"
+#include "benchmark.hpp"
+#include "scene.hpp"
 #include "box_file.hpp"
 #include "bpaccel_params.h"
 #include "broad_phase.hpp"
@@ -80,6 +85,74 @@ int runPairs(const std::string& input, const std::string& backendName, const std
   return 0;
 }
 
+// Default clock: the Fmax the FPGA flow measured for this configuration, if it ran.
+std::pair<double, std::string> defaultClock(const std::string& fpgaReport) {
+  std::ifstream in(fpgaReport);
+  if (in) {
+    try {
+      const auto j = nlohmann::json::parse(in);
+      const double mhz = j.at("fmax_mhz").get<double>();
+      if (j.value("m", 0) == BPACCEL_M && mhz > 0)
+        return {mhz * 1e6, fmt::format("Fmax {:.1f} MHz measured by nextpnr ({})", mhz, fpgaReport)};
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "bpaccel: ignoring FPGA report {}: {}\n", fpgaReport, e.what());
+    }
+  }
+  return {100e6, "default 100 MHz (no FPGA report at " + fpgaReport + ")"};
+}
+
+int runBench(bpaccel::BenchConfig config, const std::vector<std::string>& cells, double clockMHz,
+             const std::string& fpgaReport) {
+  config.cellSizes.clear();
+  for (const auto& c : cells) config.cellSizes.push_back(parseCellSize(c));
+  if (clockMHz > 0) {
+    config.clockHz = clockMHz * 1e6;
+    config.clockSource = fmt::format("--clock-mhz {}", clockMHz);
+  } else {
+    std::tie(config.clockHz, config.clockSource) = defaultClock(fpgaReport);
+  }
+  fmt::print(stderr, "bench: clock {}\n", config.clockSource);
+  bpaccel::Benchmark bench(config, [](const std::string& line) { fmt::print(stderr, "bench: {}\n", line); });
+  nlohmann::json results;
+  try {
+    results = bench.run();
+  } catch (const bpaccel::ValidationFailure& e) {
+    fmt::print(stderr, "bench: VALIDATION FAILED: {}\n", e.what());
+    return 3;
+  }
+  const std::filesystem::path path(config.jsonPath);
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  std::ofstream(path) << results.dump(2) << "\n";
+  fmt::print("{}", bpaccel::Benchmark::table(results));
+  fmt::print("\nAll frames validated. Results: {}\n", config.jsonPath);
+  bool bulletMissed = false;
+  for (const auto& r : results["rows"])
+    for (const auto& m : r["methods"])
+      if (m["missing_pairs"].get<std::uint64_t>() > 0) bulletMissed = true;
+  if (bulletMissed) {
+    fmt::print(stderr, "bench: WARNING: a Bullet broad phase missed exact pairs (see the table above)\n");
+    return 4;
+  }
+  return 0;
+}
+
+int runScene(const bpaccel::SceneConfig& config, std::size_t frames, const std::string& out) {
+  bpaccel::BouncingCubeScene scene(config);
+  for (std::size_t f = 0; f < frames; ++f) scene.step();
+  nlohmann::json j;
+  j["cube_edge"] = scene.cubeEdge();
+  j["frame"] = frames;
+  j["objects"] = nlohmann::json::array();
+  for (const auto& p : scene.poses())
+    j["objects"].push_back({{"shape", p.shape}, {"position", p.position}, {"rotation", p.rotation},
+                            {"half_extents", p.halfExtents}});
+  const std::filesystem::path path(out);
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  std::ofstream(path) << j.dump(1) << "\n";
+  fmt::print(stderr, "scene: wrote {} objects after {} frames to {}\n", scene.size(), frames, out);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -99,8 +172,56 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   pairs->add_flag("--stats", stats, "Print cycles and timings to stderr");
 
+  bpaccel::BenchConfig bench;
+  std::vector<std::string> benchCells = {"none", "16", "32", "64", "128", "256"};
+  double clockMHz = 0, linkGBps = 4, linkLatencyUs = 1;
+  std::string fpgaReport = fmt::format("results/fpga/m{}.json", BPACCEL_M);
+  bool noSimple = false;
+  auto* benchCmd = app.add_subcommand("bench", "Bouncing-cube benchmark: Bullet's broad phases against the accelerator");
+  auto addSceneOptions = [](CLI::App* cmd, bpaccel::SceneConfig& sc) {
+    cmd->add_option("--seed", sc.seed, "Scene seed")->capture_default_str();
+    cmd->add_option("--density", sc.density, "Objects per unit volume (sets the cube's edge)")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    cmd->add_option("--min-size", sc.minSize, "Smallest object size")->check(CLI::PositiveNumber)->capture_default_str();
+    cmd->add_option("--max-size", sc.maxSize, "Largest object size")->check(CLI::PositiveNumber)->capture_default_str();
+    cmd->add_option("--max-speed", sc.maxSpeed, "Largest initial speed per axis")->capture_default_str();
+  };
+  benchCmd->add_option("--objects", bench.objectCounts, "Object counts, one table row each")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  benchCmd->add_option("--cell-sizes", benchCells, "k-d tree cell sizes ('none' = no tree)")->capture_default_str();
+  benchCmd->add_option("--backend", bench.accelBackend, "Where device cycles come from: rtl (Verilated) or model")
+      ->check(CLI::IsMember({"rtl", "model"}))->capture_default_str();
+  benchCmd->add_option("--frames", bench.frames, "Timed frames per row")->check(CLI::PositiveNumber)->capture_default_str();
+  benchCmd->add_option("--warmup", bench.warmup, "Untimed frames before them")->capture_default_str();
+  benchCmd->add_option("--clock-mhz", clockMHz, "Accelerator clock (default: measured Fmax, else 100 MHz)");
+  benchCmd->add_option("--fpga-report", fpgaReport, "FPGA flow report whose Fmax is the default clock")
+      ->capture_default_str();
+  benchCmd->add_option("--link-gbps", linkGBps, "Modelled link bandwidth, GB/s")->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  benchCmd->add_option("--link-latency-us", linkLatencyUs, "Modelled latency per accelerator run, us")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  benchCmd->add_option("--json", bench.jsonPath, "Where to write every figure")->capture_default_str();
+  benchCmd->add_flag("--no-simple", noSimple, "Skip btSimpleBroadphase (O(n^2)) for huge scenes");
+  addSceneOptions(benchCmd, bench.scene);
+
+  bpaccel::SceneConfig sceneConfig;
+  std::size_t sceneFrames = 30;
+  std::string sceneOut = "results/scene.json";
+  auto* sceneCmd = app.add_subcommand("scene", "Simulate a scene and write its objects' poses as JSON for rendering");
+  sceneCmd->add_option("--objects", sceneConfig.objects, "Objects")->capture_default_str()->check(CLI::PositiveNumber);
+  sceneCmd->add_option("--frames", sceneFrames, "Frames to simulate first")->capture_default_str();
+  sceneCmd->add_option("--out", sceneOut, "Output JSON")->capture_default_str();
+  addSceneOptions(sceneCmd, sceneConfig);
+
   CLI11_PARSE(app, argc, argv);
   try {
+    if (*benchCmd) {
+      bench.link.bandwidthBytesPerSecond = linkGBps * 1e9;
+      bench.link.latencySecondsPerRun = linkLatencyUs * 1e-6;
+      bench.includeSimple = !noSimple;
+      return runBench(bench, benchCells, clockMHz, fpgaReport);
+    }
+    if (*sceneCmd) return runScene(sceneConfig, sceneFrames, sceneOut);
     parseCellSize(cellSize);
     return runPairs(input, backendName, cellSize, stats);
   } catch (const CLI::ValidationError& e) {

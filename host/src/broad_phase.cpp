@@ -88,7 +88,9 @@ void BroadPhase::runBatch(std::span<const KeyBox> keys, std::span<const std::uin
   batch_.resize(items.size());
   for (std::size_t t = 0; t < items.size(); ++t) batch_[t] = keys[items[t]];
   local_.clear();
+  const auto t0 = Clock::now();
   backend_.run(batch_, local_, stats_);
+  times_.backendSeconds += seconds(t0, Clock::now());
   for (const auto& [a, b] : local_) {
     const bool firstA = a < splitAt, firstB = b < splitAt;
     const int kind = firstA != firstB ? kCross : (firstA ? kFirstInside : kSecondInside);

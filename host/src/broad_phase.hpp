@@ -17,6 +17,7 @@ struct HostTimes {
   double convertSeconds = 0;  // float to key conversion and validation
   double treeSeconds = 0;     // k-d tree build
   double cellsSeconds = 0;    // packing, backend runs, decoding and filtering
+  double backendSeconds = 0;  // inside Backend::run (simulating the device, or the cpu test itself)
   double totalSeconds = 0;
 };
 

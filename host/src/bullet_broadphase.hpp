@@ -1,0 +1,43 @@
+#pragma once
+// Bullet's own broad phases, kept across frames as Bullet users keep them.
+
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "types.hpp"
+
+class btBroadphaseInterface;
+class btBroadphaseProxy;
+class btCollisionDispatcher;
+class btDefaultCollisionConfiguration;
+
+namespace bpaccel {
+
+class BulletBroadphase {
+ public:
+  enum class Kind { Dbvt, AxisSweep32, Simple };
+  static std::string name(Kind kind);
+
+  /// Creates one proxy per box. `worldMin`/`worldMax` bound the sweep-and-prune's quantisation.
+  BulletBroadphase(Kind kind, std::span<const Aabb> initial, float worldMin, float worldMax);
+  ~BulletBroadphase();
+  BulletBroadphase(const BulletBroadphase&) = delete;
+  BulletBroadphase& operator=(const BulletBroadphase&) = delete;
+
+  /// setAabb for every object and calculateOverlappingPairs: the work timed per frame.
+  void update(std::span<const Aabb> boxes);
+  /// The pairs in the broad phase's pair cache (i < j, unsorted).
+  void pairs(std::vector<Pair>& out) const;
+  Kind kind() const { return kind_; }
+
+ private:
+  Kind kind_;
+  std::unique_ptr<btDefaultCollisionConfiguration> config_;
+  std::unique_ptr<btCollisionDispatcher> dispatcher_;
+  std::unique_ptr<btBroadphaseInterface> broadphase_;
+  std::vector<btBroadphaseProxy*> proxies_;
+};
+
+}  // namespace bpaccel
