@@ -15,7 +15,12 @@ HOST_VERILOG := build/verilog/m$(M)-c$(CAPACITY)
 HOST_BUILD   := build/host-m$(M)-c$(CAPACITY)
 SCALA_SOURCES := $(wildcard src/bpaccel/*.scala) build.sbt
 
-.PHONY: all deps test test-hw test-host host verilog clean
+# Debian's interpreter, which has python3-matplotlib.
+PYTHON := /usr/bin/python3
+# Extra options for `bpaccel bench` (see `build/bin/bpaccel bench --help`).
+BENCH_ARGS ?=
+
+.PHONY: all deps test test-hw test-host host bench verilog clean
 
 all: test
 
@@ -40,6 +45,14 @@ host: deps $(HOST_VERILOG)/filelist.f
 
 test-host: host
 	ctest --test-dir $(HOST_BUILD) --output-on-failure -j 2
+
+# The seed's results table: Bullet's broad phases against the accelerator on
+# the bouncing cube, with results/bench.json, plots and a picture of the scene.
+bench: host
+	build/bin/bpaccel bench --json results/bench.json $(BENCH_ARGS)
+	$(PYTHON) scripts/plot_bench.py --json results/bench.json --out-dir results
+	build/bin/bpaccel scene --objects 100 --frames 30 --out results/scene.json
+	$(PYTHON) scripts/render_scene.py --json results/scene.json --out results/scene.png
 
 # SystemVerilog (one file per module, filelist.f) and bpaccel_params.h for one configuration.
 verilog: deps

@@ -21,36 +21,36 @@ void KdTree::build(std::span<const KeyBox> boxes, std::size_t cellSize) {
   }
 }
 
-// Tries the axes from widest spread of box centres down; splits at the
-// median centre. A split must shrink both children and may duplicate at most
-// a quarter of the boxes, which bounds the tree's size to O(n) per level.
+// Chooses the plane from a fixed-size sample of box centres (a strided
+// sample keeps the cost per node constant, so a level costs two passes over
+// its boxes: count, then partition). Tries the axes from widest sampled
+// spread down and splits at the sampled median. A split must shrink both
+// children and may duplicate at most a quarter of the boxes, which bounds
+// the tree's size.
 bool KdTree::split(std::span<const KeyBox> boxes, const Task& task) {
+  constexpr std::uint32_t kSamples = 63;
+  const std::uint32_t samples = std::min(kSamples, task.count);
+  std::array<std::array<std::uint64_t, kSamples>, 3> centres;  // twice the centre, per axis
+  for (std::uint32_t t = 0; t < samples; ++t) {
+    const KeyBox& b = boxes[pool_[task.begin + static_cast<std::uint32_t>(std::uint64_t{t} * task.count / samples)]];
+    for (int a = 0; a < 3; ++a) centres[a][t] = std::uint64_t{b.min[a]} + b.max[a];
+  }
   std::array<std::uint64_t, 3> spread{}, lowest{};
   for (int a = 0; a < 3; ++a) {
-    std::uint64_t lo = UINT64_MAX, hi = 0;
-    for (std::uint32_t t = 0; t < task.count; ++t) {
-      const KeyBox& b = boxes[pool_[task.begin + t]];
-      const std::uint64_t c = std::uint64_t{b.min[a]} + b.max[a];  // twice the centre
-      lo = std::min(lo, c);
-      hi = std::max(hi, c);
-    }
-    spread[a] = hi - lo;
-    lowest[a] = lo;
+    const auto [lo, hi] = std::minmax_element(centres[a].begin(), centres[a].begin() + samples);
+    spread[a] = *hi - *lo;
+    lowest[a] = *lo;
   }
   std::array<int, 3> axes{0, 1, 2};
   std::sort(axes.begin(), axes.end(), [&](int x, int y) { return spread[x] > spread[y]; });
 
   for (int axis : axes) {
     if (spread[axis] == 0) break;
-    centres_.resize(task.count);
-    for (std::uint32_t t = 0; t < task.count; ++t) {
-      const KeyBox& b = boxes[pool_[task.begin + t]];
-      centres_[t] = std::uint64_t{b.min[axis]} + b.max[axis];
-    }
-    auto mid = centres_.begin() + task.count / 2;
-    std::nth_element(centres_.begin(), mid, centres_.end());
-    // Plane in key space: ceil(median centre); strictly above the lowest centre so both sides get boxes.
-    std::uint64_t plane = std::max((*mid + 1) / 2, (lowest[axis] + 2) / 2);
+    auto* c = centres[axis].data();
+    std::nth_element(c, c + samples / 2, c + samples);
+    const std::uint64_t median = c[samples / 2];
+    // Plane in key space: ceil(median centre), strictly above the lowest sampled centre.
+    std::uint64_t plane = std::max((median + 1) / 2, (lowest[axis] + 2) / 2);
     plane = std::max(plane, task.lo[axis] + 1);
     if (plane >= task.hi[axis]) continue;
 

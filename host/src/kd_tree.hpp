@@ -44,7 +44,6 @@ class KdTree {
   bool split(std::span<const KeyBox> boxes, const Task& task);
 
   std::vector<std::uint32_t> pool_;      // item lists of all nodes, appended as built
-  std::vector<std::uint64_t> centres_;   // scratch for the median
   std::vector<Task> stack_;
   std::vector<Leaf> leaves_;
 };

