@@ -24,8 +24,8 @@ struct BenchConfig {
   std::vector<std::size_t> objectCounts{100, 1000, 8000};
   std::vector<std::optional<std::size_t>> cellSizes{std::nullopt, 16, 32, 64, 128, 256};
   std::string accelBackend = "rtl";  // rtl or model: where the device's cycles come from
-  std::size_t frames = 20;           // timed frames per row
-  std::size_t warmup = 3;            // frames simulated and run but not timed
+  std::size_t frames = 50;           // timed frames per row
+  std::size_t warmup = 5;            // frames simulated and run but not timed
   SceneConfig scene;                 // objects is set per row
   double clockHz = 100e6;
   std::string clockSource = "default 100 MHz";
