@@ -412,6 +412,9 @@ def flow(args) -> int:
                 (", ".join(f"{k} {v['used']}/{v['available']}" for k, v in over.items()) or nofit_msg.group(0)))
             if not args.no_xilinx:
                 xil = xilinx(runner, args.debian_yosys, src_list, m)
+            breakdown = None
+            if not args.no_breakdown:
+                breakdown = ecp5_breakdown(runner, yosys, src_list, mods, mem_modules)
             result.update({
                 "status": "does_not_fit",
                 "fits": False,
@@ -426,6 +429,7 @@ def flow(args) -> int:
                     "synth_cells": ecp5_cells,
                 },
                 "xilinx_estimate": xil,
+                "breakdown_ecp5_synth": breakdown,
                 "runtime_s": dict(runner.runtimes, venv_setup=venv_setup_s,
                                   total=round(time.monotonic() - t_start, 1)),
             })
@@ -474,6 +478,7 @@ def flow(args) -> int:
             "bram_dp16kd": util_used(rutil, "DP16KD"),
             "fmax_mhz": round(fmax, 2),
             "fmax_source": f"nextpnr-ecp5 timing analysis of the placed and routed design, clock net {clk_net}",
+            "critical_path": critical_path(rep, clk_net),
             "clock_constraint_mhz": args.clock_mhz,
             "timing_met": fmax >= args.clock_mhz,
             "pair_tests_per_second": round(m * fmax * 1e6),
@@ -509,6 +514,33 @@ def flow(args) -> int:
     write_json(out, result)
     print_summary(result)
     return EXIT_OK
+
+
+def critical_path(rep: dict, clk_net: str) -> dict | None:
+    """The register-to-register critical path of the clock, from nextpnr's report."""
+    for cp in rep.get("critical_paths", []):
+        if clk_net in cp.get("from", "") and clk_net in cp.get("to", ""):
+            path = cp.get("path", [])
+            if not path:
+                return None
+            kinds: dict[str, float] = {}
+            for seg in path:
+                kinds[seg["type"]] = kinds.get(seg["type"], 0.0) + seg["delay"]
+            sources = []
+            for seg in path:
+                for src in seg.get("sources", []):
+                    if not src.startswith("/share") and src not in sources:
+                        sources.append(src)
+            return {
+                "delay_ns": round(sum(kinds.values()), 2),
+                "routing_ns": round(kinds.get("routing", 0.0), 2),
+                "logic_ns": round(sum(v for k, v in kinds.items() if k != "routing"), 2),
+                "logic_cells": sum(1 for seg in path if seg["type"] == "logic"),
+                "from_cell": path[0]["from"]["cell"],
+                "to_cell": path[-1]["to"]["cell"],
+                "verilog_sources": sources,
+            }
+    return None
 
 
 def util_used(util: dict, key: str):
@@ -597,14 +629,19 @@ def xilinx(runner: Runner, debian_yosys: str, src_list: str, m: int) -> dict:
 
 
 def ecp5_breakdown(runner: Runner, yosys: str, src_list: str, mods: list[str], mem_modules: list[str]) -> dict:
-    """synth_ecp5 of the bare core with its direct submodules kept as hierarchy
-    (memories are flattened into CoordBuffer, where both memory clocks are `clock`)."""
-    subs = [n for n in mods if n != TOP and n not in mem_modules]
+    """synth_ecp5 of the bare core with the logic submodules kept as hierarchy.
+
+    Submodules that hold the memories (CoordBuffer) are flattened into the top as in
+    the real run: the memory output register lives in the top, and only a flat view
+    lets Yosys pack it into the DP16KD (kept apart, the memories need extra logic)."""
+    texts = {n: t for n, t in module_texts(runner.work, src_list.split()).items()}
+    holds_mem = {n for n, t in texts.items() if any(re.search(rf"^\s*{mm}\s+\w+\s*\(", t, re.M) for mm in mem_modules)}
+    subs = [n for n in mods if n != TOP and n not in mem_modules and n not in holds_mem]
     (runner.work / "breakdown.ys").write_text(
         f"read_verilog -sv {src_list}\n"
         f"hierarchy -top {TOP}\n"
-        f"setattr -mod -set keep_hierarchy 1 {' '.join(subs)}\n"
-        f"synth_ecp5 -top {TOP}\n"
+        + (f"setattr -mod -set keep_hierarchy 1 {' '.join(subs)}\n" if subs else "")
+        + f"synth_ecp5 -top {TOP}\n"
         f"tee -q -o breakdown_stat.json stat -json\n")
     code, _ = runner.run("yosys breakdown", [yosys, "-q", "-l", "breakdown.log", "-s", "breakdown.ys"],
                          "breakdown.stdout")
@@ -614,16 +651,28 @@ def ecp5_breakdown(runner: Runner, yosys: str, src_list: str, mods: list[str], m
     out = {}
     for name, cells in per.items():
         cells = {k: v for k, v in cells.items() if k not in subs and k != "$scopeinfo"}
-        out[name if name != TOP else f"{TOP} (top-level glue)"] = {
+        label = name if name != TOP else f"{TOP} + {', '.join(sorted(holds_mem))} (top level, memories)"
+        out[label] = {
             "lut4_slots": comb_cells(cells),
             "ffs": cells.get("TRELLIS_FF", 0),
             "dp16kd": cells.get("DP16KD", 0),
             "ccu2c": cells.get("CCU2C", 0),
             "cells": cells,
         }
-    return {"what": "post-synthesis (not placed) ECP5 cells per module of the bare core; "
+    return {"what": "post-synthesis (not placed) ECP5 cells per module of the bare core (no wrapper); "
                     "lut4_slots = LUT4 + 2*CCU2C; no optimisation across these module boundaries",
+            "kept_modules": subs,
+            "flattened_into_top": sorted(holds_mem),
             "modules": out}
+
+
+def module_texts(work: Path, files: list[str]) -> dict[str, str]:
+    out = {}
+    for f in files:
+        text = (work / f).read_text()
+        for mm in re.finditer(r"^\s*module\s+(\w+)(.*?)^\s*endmodule", text, re.M | re.S):
+            out[mm.group(1)] = mm.group(2)
+    return out
 
 
 def write_json(path: Path, data: dict) -> None:
