@@ -22,11 +22,10 @@ void KdTree::build(std::span<const KeyBox> boxes, std::size_t cellSize) {
 }
 
 // Chooses the plane from a fixed-size sample of box centres (a strided
-// sample keeps the cost per node constant, so a level costs two passes over
-// its boxes: count, then partition). Tries the axes from widest sampled
+// sample keeps the cost per node constant). Tries the axes from widest sampled
 // spread down and splits at the sampled median. A split must shrink both
 // children and may duplicate at most a quarter of the boxes, which bounds
-// the tree's size.
+// the tree's size. Each level costs one pass over its boxes.
 bool KdTree::split(std::span<const KeyBox> boxes, const Task& task) {
   constexpr std::uint32_t kSamples = 63;
   const std::uint32_t samples = std::min(kSamples, task.count);
@@ -54,26 +53,26 @@ bool KdTree::split(std::span<const KeyBox> boxes, const Task& task) {
     plane = std::max(plane, task.lo[axis] + 1);
     if (plane >= task.hi[axis]) continue;
 
-    std::uint32_t left = 0, right = 0;
-    for (std::uint32_t t = 0; t < task.count; ++t) {
-      const KeyBox& b = boxes[pool_[task.begin + t]];
-      left += b.min[axis] < plane;
-      right += b.max[axis] >= plane;
-    }
-    if (left >= task.count || right >= task.count || left + right > task.count + task.count / 4) continue;
-
-    // Append both children's item lists to the pool (resize first: the
-    // parent's list lives in the same vector).
+    // One pass: left children straight onto the pool's end, right ones into
+    // scratch; appended after the left ones only if the split is accepted.
     const auto leftBegin = static_cast<std::uint32_t>(pool_.size());
-    pool_.resize(pool_.size() + left + right);
-    std::uint32_t* l = pool_.data() + leftBegin;
-    std::uint32_t* r = l + left;
+    pool_.resize(pool_.size() + task.count);
+    right_.resize(task.count);
+    std::uint32_t left = 0, right = 0;
     for (std::uint32_t t = 0; t < task.count; ++t) {
       const std::uint32_t id = pool_[task.begin + t];
       const KeyBox& b = boxes[id];
-      if (b.min[axis] < plane) *l++ = id;
-      if (b.max[axis] >= plane) *r++ = id;
+      pool_[leftBegin + left] = id;
+      right_[right] = id;
+      left += b.min[axis] < plane;
+      right += b.max[axis] >= plane;
     }
+    if (left >= task.count || right >= task.count || left + right > task.count + task.count / 4) {
+      pool_.resize(leftBegin);
+      continue;
+    }
+    pool_.resize(leftBegin + left);
+    pool_.insert(pool_.end(), right_.begin(), right_.begin() + right);
     Task lower = task, upper = task;
     lower.begin = leftBegin;
     lower.count = left;

@@ -44,6 +44,7 @@ class KdTree {
   bool split(std::span<const KeyBox> boxes, const Task& task);
 
   std::vector<std::uint32_t> pool_;      // item lists of all nodes, appended as built
+  std::vector<std::uint32_t> right_;     // scratch: the upper child's items while splitting
   std::vector<Task> stack_;
   std::vector<Leaf> leaves_;
 };
