@@ -9,7 +9,10 @@ import chisel3.util.log2Ceil
   * @param capacity         most objects one run can hold; a multiple of m
   * @param keyWidth         bits of one coordinate key (order-preserving image of a float32)
   * @param resultQueueDepth result beats buffered before the sequencer must stall
-  * @param bufferOutputReg  register the memory outputs (the BRAM output register) for Fmax
+  * @param memoryOutputStages registers after each memory's read data. FPGA synthesis folds
+  *                         the first into the block RAM's synchronous read, so it takes
+  *                         two for the rotator to start from a fabric register (measured:
+  *                         with one, the BRAM's clock-to-out fed the rotator directly)
   * @param debugPort        add a port that shows every lane's (i, j, valid) per cycle, for tests
   */
 case class AccelParams(
@@ -17,7 +20,7 @@ case class AccelParams(
   capacity: Int = AccelParams.defaultCapacity(8),
   keyWidth: Int = 32,
   resultQueueDepth: Int = 16,
-  bufferOutputReg: Boolean = true,
+  memoryOutputStages: Int = 2,
   debugPort: Boolean = false
 ) {
   require(m >= 1, s"parallelism m must be at least 1, got m = $m")
@@ -25,6 +28,10 @@ case class AccelParams(
   require(
     capacity % m == 0,
     s"capacity must be a multiple of m so the objects stripe evenly: capacity = $capacity, m = $m"
+  )
+  require(
+    memoryOutputStages >= 0 && memoryOutputStages <= 4,
+    s"memoryOutputStages must lie in 0..4, got $memoryOutputStages"
   )
   require(keyWidth >= 1 && keyWidth <= 64, s"keyWidth must lie in 1..64, got keyWidth = $keyWidth")
   require(m < (1 << 16) && capacity.toLong < (1L << 32), s"m must fit 16 bits and capacity 32 bits, got m = $m, capacity = $capacity")
@@ -48,9 +55,9 @@ case class AccelParams(
   val laneWidth: Int = log2Ceil(m).max(1)
 
   /** Cycles from an issue of the sequencer to its hit mask: memory read,
-    * optional output register, rotator register, comparator register.
+    * memory output registers, rotator register, comparator register.
     */
-  val pipelineLatency: Int = if (bufferOutputReg) 4 else 3
+  val pipelineLatency: Int = 1 + memoryOutputStages + 2
 
   /** Cycles a run of n >= 2 objects takes beyond its issue cycles when the
     * consumer never stalls: the pipeline's latency plus the cycle that sees it

@@ -18,7 +18,7 @@ import chisel3.util._
   * itself never stalls and no hit is ever dropped or duplicated.
   *
   * Pipeline, one schedule cycle per clock when unstalled:
-  * issue -> memory read -> [memory output register] -> rotator register ->
+  * issue -> memory read -> memory output registers -> rotator register ->
   * comparator/AND register -> result queue (flow-through).
   */
 class BroadPhaseAccel(val p: AccelParams) extends Module {
@@ -148,11 +148,12 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
     r
   }
 
-  // Memory read (1 cycle) and optional output register.
+  // Memory read (1 cycle) and the memory output registers.
   val atMemory = stage(issued)
-  val (memA, memB, atBuffered) =
-    if (p.bufferOutputReg) (RegNext(buffer.io.a), RegNext(buffer.io.b), stage(atMemory))
-    else (buffer.io.a, buffer.io.b, atMemory)
+  val memoryStages = Seq.iterate((buffer.io.a, buffer.io.b, atMemory), p.memoryOutputStages + 1) {
+    case (a, b, meta) => (RegNext(a), RegNext(b), stage(meta))
+  }
+  val (memA, memB, atBuffered) = memoryStages.last
   // Rotator, registered.
   val rotatedB  = RegNext(Rotator(memB, atBuffered.bits.rotate))
   val alignedA  = RegNext(memA)
@@ -163,7 +164,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   val hitMask   = RegNext(compare.io.hits & atRotated.bits.laneMask)
   val atCompare = stage(atRotated)
 
-  val stages = Seq(atMemory) ++ (if (p.bufferOutputReg) Seq(atBuffered) else Nil) ++ Seq(atRotated, atCompare)
+  val stages = memoryStages.map(_._3) ++ Seq(atRotated, atCompare)
   require(stages.length == p.pipelineLatency)
   inFlight := PopCount(stages.map(_.valid))
 

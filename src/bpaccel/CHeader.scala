@@ -7,7 +7,7 @@ object CHeader {
   /** One string that names the whole configuration; the host compares it. */
   def fingerprint(p: AccelParams): String =
     s"m=${p.m},capacity=${p.capacity},key_width=${p.keyWidth},queue=${p.resultQueueDepth}," +
-      s"outreg=${if (p.bufferOutputReg) 1 else 0},debug=${if (p.debugPort) 1 else 0}"
+      s"memstages=${p.memoryOutputStages},debug=${if (p.debugPort) 1 else 0}"
 
   def apply(p: AccelParams): String = {
     val defines = Seq(

@@ -16,12 +16,12 @@ object EmitVerilog {
     capacity: Option[Int] = None,
     keyWidth: Int = AccelParams().keyWidth,
     queueDepth: Int = AccelParams().resultQueueDepth,
-    outputReg: Boolean = AccelParams().bufferOutputReg,
+    memoryOutputStages: Int = AccelParams().memoryOutputStages,
     debugPort: Boolean = false,
     targetDir: Path = Paths.get("generated")
   ) {
     def params: AccelParams =
-      AccelParams(m, capacity.getOrElse(AccelParams.defaultCapacity(m)), keyWidth, queueDepth, outputReg, debugPort)
+      AccelParams(m, capacity.getOrElse(AccelParams.defaultCapacity(m)), keyWidth, queueDepth, memoryOutputStages, debugPort)
   }
 
   /** firtool options that keep the output plain enough for Yosys, Verilator and vendor tools. */
@@ -51,7 +51,9 @@ object EmitVerilog {
         .text(s"objects per run, a multiple of m (default ${AccelParams.defaultRows} * m)")
       opt[Int]("key-width").action((v, o) => o.copy(keyWidth = v)).text("bits per coordinate key")
       opt[Int]("queue-depth").action((v, o) => o.copy(queueDepth = v)).text("result queue beats")
-      opt[Boolean]("output-reg").action((v, o) => o.copy(outputReg = v)).text("register the memory outputs")
+      opt[Int]("memory-output-stages")
+        .action((v, o) => o.copy(memoryOutputStages = v))
+        .text("registers after the memories' read data (default 2)")
       opt[Boolean]("debug-port").action((v, o) => o.copy(debugPort = v)).text("add the per-lane debug probe")
       opt[String]("target-dir").action((v, o) => o.copy(targetDir = Paths.get(v))).text("output folder")
     }

@@ -24,6 +24,16 @@ class AccelParamsSpec extends AnyFlatSpec with Matchers {
     rejection(AccelParams(keyWidth = 65)) should include("keyWidth")
   }
 
+  it should "reject memory output stages outside 0..4" in {
+    rejection(AccelParams(memoryOutputStages = -1)) should include("memoryOutputStages")
+    rejection(AccelParams(memoryOutputStages = 5)) should include("memoryOutputStages")
+  }
+
+  it should "count every register of the pipeline in its latency" in {
+    AccelParams(memoryOutputStages = 0).pipelineLatency shouldBe 3
+    AccelParams().pipelineLatency shouldBe 5
+  }
+
   it should "reject a result queue too shallow to keep the pipeline streaming" in {
     rejection(AccelParams(resultQueueDepth = 2)) should include("resultQueueDepth")
   }

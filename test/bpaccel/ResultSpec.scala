@@ -45,6 +45,20 @@ class ResultSpec extends AnyFlatSpec with Simulators with Checks {
       }
     }
 
+  for (stages <- Seq(0, 1, 3))
+    it should s"report exactly the brute-force pairs with $stages memory output stages (m=3)" in {
+      val p = AccelParams(m = 3, capacity = 24, memoryOutputStages = stages)
+      onVerilator(p) { dut =>
+        val drv = new AccelDriver(dut)
+        drv.idleInputs()
+        val rng = new Random(30 + stages)
+        for ((scene, boxes) <- Box.Scenes.all(rng, 24, p.keyWidth)) withClue(s"scene '$scene': ") {
+          checkRun(p, boxes, drv.run(boxes, c => c % 5 != 2), consumerNeverStalls = false)
+          checkRun(p, boxes, drv.run(boxes), consumerNeverStalls = true)
+        }
+      }
+    }
+
   it should "work with narrow keys (8 bits) at the ends of their range" in {
     val p = AccelParams(m = 4, capacity = 32, keyWidth = 8)
     onVerilator(p) { dut =>
