@@ -45,7 +45,7 @@ class AccelCounters(p: AccelParams) extends Bundle {
   val cycles      = UInt(p.counterWidth.W) // start accepted .. done
   val issueCycles = UInt(p.counterWidth.W) // cycles the comparator array was given work
   val stallCycles = UInt(p.counterWidth.W) // cycles the sequencer waited on the result queue
-  val hits        = UInt(p.counterWidth.W) // pairs handed to the consumer
+  val hits        = UInt(p.counterWidth.W) // pairs reported (all handed to the consumer by done)
 }
 
 /** What one lane tested in one schedule cycle, seen at the comparator output. */
