@@ -20,7 +20,10 @@ PYTHON := /usr/bin/python3
 # Extra options for `bpaccel bench` (see `build/bin/bpaccel bench --help`).
 BENCH_ARGS ?=
 
-.PHONY: all deps test test-hw test-host host bench verilog clean
+# The FPGA flow's own test runs on this configuration.
+FPGA_TEST_VERILOG := build/fpga-verilog/test-m2
+
+.PHONY: all deps test test-hw test-host test-fpga host bench verilog fpga fpga-sweep clean
 
 all: test
 
@@ -28,7 +31,7 @@ deps:
 	@./scripts/deps.sh
 
 # Every test of the project.
-test: deps test-hw test-host
+test: deps test-hw test-host test-fpga
 
 # The Chisel generator: golden model, ChiselTest (Scala simulator and Verilator),
 # Verilog lint and memory structure.
@@ -49,10 +52,25 @@ test-host: host
 # The seed's results table: Bullet's broad phases against the accelerator on
 # the bouncing cube, with results/bench.json, plots and a picture of the scene.
 bench: host
-	build/bin/bpaccel bench --json results/bench.json $(BENCH_ARGS)
+	mkdir -p results; set -o pipefail; build/bin/bpaccel bench --json results/bench.json $(BENCH_ARGS) | tee results/bench.txt
 	$(PYTHON) scripts/plot_bench.py --json results/bench.json --out-dir results
 	build/bin/bpaccel scene --objects 100 --frames 30 --out results/scene.json
 	$(PYTHON) scripts/render_scene.py --json results/scene.json --out results/scene.png
+
+# FPGA flow (docs/fpga.md): ECP5 synthesis, place and route with a measured
+# Fmax, and a Xilinx 7-series synthesis estimate.
+fpga: deps
+	$(MAKE) verilog M=$(M) CAPACITY=$(CAPACITY) KEY_WIDTH=$(KEY_WIDTH) VERILOG_DIR=build/fpga-verilog/m$(M)
+	$(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/m$(M) --m $(M) --out results/fpga/m$(M).json
+
+fpga-sweep: deps
+	$(PYTHON) scripts/fpga/sweep.py --verilog-root build/fpga-verilog --emit always --budget-min 60
+
+$(FPGA_TEST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
+	$(SBT) "runMain bpaccel.EmitVerilog --m 2 --target-dir $(FPGA_TEST_VERILOG)"
+
+test-fpga: deps $(FPGA_TEST_VERILOG)/filelist.f
+	$(PYTHON) scripts/fpga/test_flow.py $(FPGA_TEST_VERILOG)
 
 # SystemVerilog (one file per module, filelist.f) and bpaccel_params.h for one configuration.
 verilog: deps

@@ -7,7 +7,7 @@ debian_packages=(
   default-jdk-headless maven           # sbt runs on the JDK; Maven fetches the sbt launcher
   verilator g++ cmake ninja-build make pkg-config
   libbullet-dev googletest libgtest-dev nlohmann-json3-dev libcli11-dev libfmt-dev
-  python3-venv python3-matplotlib
+  python3-venv python3-matplotlib yosys  # plots; the FPGA flow (its PyPI tools go into .venv)
 )
 
 missing=()

@@ -310,14 +310,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", type=Path, help="JSON report (default results/fpga/m<M>.json)")
     ap.add_argument("--venv", type=Path, default=REPO / ".venv", help="virtual env for the yowasp tools")
     ap.add_argument("--clock-mhz", type=float, default=200.0, help="clock constraint given to nextpnr")
-    ap.add_argument("--work-dir", type=Path, help="scratch dir (default results/fpga/work/m<M>)")
+    ap.add_argument("--work-dir", type=Path, help="scratch dir (default: work/<name of --out without .json> beside --out)")
     ap.add_argument("--seed", type=int, default=1, help="nextpnr placer seed")
+    ap.add_argument("--router", choices=["router1", "router2"], default="router1",
+                    help="nextpnr router (router2 is faster on congested designs, router1 gave higher Fmax at m = 8)")
     ap.add_argument("--timeout", type=float, default=None, help="seconds for the whole run (exit 4 past it)")
     ap.add_argument("--no-xilinx", action="store_true", help="skip the Xilinx estimate")
     ap.add_argument("--no-breakdown", action="store_true", help="skip the per-module ECP5 synthesis")
     ap.add_argument("--debian-yosys", default=DEBIAN_YOSYS, help="Yosys for synth_xilinx")
+    ap.add_argument("--update-breakdown", action="store_true",
+                    help="only redo the per-part breakdown of an existing --out report (keeps its other numbers)")
     args = ap.parse_args(argv)
     try:
+        if args.update_breakdown:
+            return update_breakdown(args)
         return flow(args)
     except FlowError as e:
         log(f"FAILED: {e}")
@@ -332,7 +338,7 @@ def flow(args) -> int:
         raise FlowError(EXIT_INPUT, "--m must be >= 1")
     vdir = args.verilog_dir.resolve()
     out = (args.out or REPO / "results" / "fpga" / f"m{m}.json").resolve()
-    work = (args.work_dir or REPO / "results" / "fpga" / "work" / f"m{m}").resolve()
+    work = (args.work_dir or out.parent / "work" / out.stem).resolve()
     # Never leave a stale report behind that a failed run could be mistaken for.
     if out.exists():
         out.unlink()
@@ -392,12 +398,34 @@ def flow(args) -> int:
     wrapper_cells, _ = stat_cells(work / "wrapper_stat.json")
     wrapper_cells.pop(TOP, None)
 
+    # ---- did the memories become block RAM?
+    n_mems = 6 * m
+    dp16 = ecp5_cells.get("DP16KD", 0)
+    bram_mapped = sum(v for k, v in ecp5_memmap.items() if "16KD" in k)
+    mems_in_bram = bram_mapped == n_mems and dp16 >= n_mems and "FF" not in ecp5_memmap \
+        and not any("DPR16X4" in k for k in ecp5_memmap)
+    per_mem = dp16 / n_mems if n_mems else None
+    memories = {
+        "instances": n_mems,
+        "module": mem_modules,
+        "ecp5_mapping": ecp5_memmap,
+        "dp16kd_per_memory": per_mem,
+        "memories_in_bram": mems_in_bram,
+        "note": ("each memory has one read/write and one read port; Yosys maps it to two "
+                 "pseudo-dual-port DP16KD (1 write + 1 read port, 512x36), written together, one per "
+                 "read port: 2 DP16KD per memory, each using 256 of its 512 rows"
+                 if mems_in_bram and per_mem == 2 else
+                 "memories are not all in DP16KD block RAM: see ecp5_mapping" if not mems_in_bram else ""),
+    }
+    if not mems_in_bram:
+        log("WARNING: memories did NOT all map to DP16KD block RAM: " + json.dumps(ecp5_memmap))
+
     # ---- ECP5 place and route
     npr_help = subprocess.run([nextpnr, "--help"], cwd=work, stdout=subprocess.PIPE,
                               stderr=subprocess.STDOUT, text=True).stdout
     npr_cmd = [nextpnr, ECP5_DEVICE_FLAG, "--package", ECP5_PACKAGE, "--json", "ecp5.json",
                "--lpf-allow-unconstrained", "--freq", f"{args.clock_mhz:g}", "--timing-allow-fail",
-               "--seed", str(args.seed), "--report", "nextpnr_report.json"]
+               "--seed", str(args.seed), "--router", args.router, "--report", "nextpnr_report.json"]
     if "--threads" in npr_help:
         npr_cmd += ["--threads", "1"]
     code, ntext = runner.run("nextpnr-ecp5", npr_cmd, "nextpnr.log")
@@ -414,7 +442,8 @@ def flow(args) -> int:
                 xil = xilinx(runner, args.debian_yosys, src_list, m)
             breakdown = None
             if not args.no_breakdown:
-                breakdown = ecp5_breakdown(runner, yosys, src_list, mods, mem_modules)
+                breakdown = ecp5_breakdown(runner, yosys, src_list, mods, mem_modules,
+                                       core_synth_cells(ecp5_cells, wrapper_cells), m)
             result.update({
                 "status": "does_not_fit",
                 "fits": False,
@@ -428,6 +457,7 @@ def flow(args) -> int:
                     "nextpnr_error": [l for l in ntext.splitlines() if "ERROR" in l][:5],
                     "synth_cells": ecp5_cells,
                 },
+                "memories": memories,
                 "xilinx_estimate": xil,
                 "breakdown_ecp5_synth": breakdown,
                 "runtime_s": dict(runner.runtimes, venv_setup=venv_setup_s,
@@ -455,14 +485,8 @@ def flow(args) -> int:
 
     breakdown = None
     if not args.no_breakdown:
-        breakdown = ecp5_breakdown(runner, yosys, src_list, mods, mem_modules)
-
-    n_mems = 6 * m
-    dp16 = ecp5_cells.get("DP16KD", 0)
-    bram_mapped = sum(v for k, v in ecp5_memmap.items() if "16KD" in k)
-    mems_in_bram = bram_mapped == n_mems and dp16 >= n_mems and "FF" not in ecp5_memmap \
-        and not any("DPR16X4" in k for k in ecp5_memmap)
-    per_mem = dp16 / n_mems if n_mems else None
+        breakdown = ecp5_breakdown(runner, yosys, src_list, mods, mem_modules,
+                                       core_synth_cells(ecp5_cells, wrapper_cells), m)
 
     lut_slots = util_used(rutil, "TRELLIS_COMB")
     ffs = util_used(rutil, "TRELLIS_FF")
@@ -492,25 +516,12 @@ def flow(args) -> int:
                 "note": "placed totals minus the wrapper synthesised alone around a black-box core",
             },
         },
-        "memories": {
-            "instances": n_mems,
-            "module": mem_modules,
-            "ecp5_mapping": ecp5_memmap,
-            "dp16kd_per_memory": per_mem,
-            "memories_in_bram": mems_in_bram,
-            "note": ("each 256x32 memory has one read/write and one read port; Yosys maps it to "
-                     "pseudo-dual-port DP16KD (1 write + 1 read, 36 bits wide) and duplicates it "
-                     "for the second read port: 2 DP16KD per memory, each a quarter full"
-                     if mems_in_bram and per_mem == 2 else
-                     "memories are not all in DP16KD block RAM: see ecp5_mapping" if not mems_in_bram else ""),
-        },
+        "memories": memories,
         "xilinx_estimate": xil,
         "breakdown_ecp5_synth": breakdown,
         "runtime_s": dict(runner.runtimes, venv_setup=venv_setup_s,
                           total=round(time.monotonic() - t_start, 1)),
     })
-    if not mems_in_bram:
-        log("WARNING: memories did NOT all map to DP16KD block RAM: " + json.dumps(ecp5_memmap))
     write_json(out, result)
     print_summary(result)
     return EXIT_OK
@@ -535,12 +546,62 @@ def critical_path(rep: dict, clk_net: str) -> dict | None:
                 "delay_ns": round(sum(kinds.values()), 2),
                 "routing_ns": round(kinds.get("routing", 0.0), 2),
                 "logic_ns": round(sum(v for k, v in kinds.items() if k != "routing"), 2),
-                "logic_cells": sum(1 for seg in path if seg["type"] == "logic"),
+                "lut_levels": sum(1 for seg in path if seg["type"] == "logic"
+                                  and seg["from"].get("port") != "FCI" and seg["to"].get("port") != "FCO"),
+                "carry_cells": sum(1 for seg in path if seg["type"] == "logic"
+                                   and (seg["from"].get("port") == "FCI" or seg["to"].get("port") == "FCO")),
                 "from_cell": path[0]["from"]["cell"],
                 "to_cell": path[-1]["to"]["cell"],
                 "verilog_sources": sources,
             }
     return None
+
+
+def update_breakdown(args) -> int:
+    m = args.m
+    out = (args.out or REPO / "results" / "fpga" / f"m{m}.json").resolve()
+    if not out.is_file():
+        raise FlowError(EXIT_INPUT, f"{out} not found: run the full flow first")
+    rep = json.loads(out.read_text())
+    if rep.get("m") != m or rep.get("status") not in ("ok", "does_not_fit"):
+        raise FlowError(EXIT_INPUT, f"{out} is not a finished report for m = {m}")
+    vdir = args.verilog_dir.resolve()
+    work = (args.work_dir or out.parent / "work" / out.stem).resolve()
+    files = read_filelist(vdir)
+    work.mkdir(parents=True, exist_ok=True)
+    for f in files:
+        shutil.copy2(vdir / f, work / f)
+    mods = module_names(work, files)
+    mem_modules = [n for n in mods if n.startswith("mem_")]
+    bins = ensure_venv(args.venv.resolve())
+    runner = Runner(work, time.monotonic() + args.timeout if args.timeout else None)
+    yosys = str(bins["yosys"])
+    ports = top_ports(runner, bins["yosys"], next(f for f in files if re.search(rf"^\s*module\s+{TOP}\b", (work / f).read_text(), re.M)))
+    wrapper_src, _ = make_wrapper(ports)
+    (work / "fpga_wrapper.v").write_text(wrapper_src)
+    (work / "core_blackbox.v").write_text(blackbox_stub(ports))
+    (work / "wrapper.ys").write_text(
+        f"read_verilog -sv core_blackbox.v fpga_wrapper.v\n"
+        f"synth_ecp5 -top {WRAPPER_TOP}\n"
+        f"tee -q -o wrapper_stat.json stat -json\n")
+    code, _ = runner.run("yosys wrapper-only", [yosys, "-q", "-l", "wrapper.log", "-s", "wrapper.ys"], "wrapper.stdout")
+    if code != 0:
+        raise FlowError(EXIT_TOOL, "synthesis of the wrapper alone failed")
+    wrapper_cells, _ = stat_cells(work / "wrapper_stat.json")
+    wrapper_cells.pop(TOP, None)
+    synth = rep["ecp5"]["synth_cells"] if rep["status"] == "ok" else rep["ecp5_demand"]["synth_cells"]
+    rep["breakdown_ecp5_synth"] = ecp5_breakdown(runner, yosys, " ".join(files), mods, mem_modules,
+                                                 core_synth_cells(synth, wrapper_cells), m)
+    rep.setdefault("runtime_s", {})["yosys breakdown"] = runner.runtimes.get("yosys breakdown")
+    npr = work / "nextpnr_report.json"
+    if rep["status"] == "ok" and npr.is_file():
+        nrep = json.loads(npr.read_text())
+        clk = next((k for k in nrep.get("fmax", {}) if "clk" in k), None)
+        if clk and abs(nrep["fmax"][clk]["achieved"] - rep["ecp5"]["fmax_mhz"]) < 0.01:
+            rep["ecp5"]["critical_path"] = critical_path(nrep, clk)
+    rep["breakdown_updated"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+    write_json(out, rep)
+    return EXIT_OK
 
 
 def util_used(util: dict, key: str):
@@ -588,6 +649,7 @@ def base_report(m, capacity, params, args, versions, wrapper_info) -> dict:
                  "xilinx": f"7-series family (synth_xilinx -family {XILINX_FAMILY}), no specific device"},
         "clock_constraint_mhz": args.clock_mhz,
         "nextpnr_seed": args.seed,
+        "nextpnr_router": getattr(args, "router", "router1"),
         "tool_versions": versions,
         "wrapper": wrapper_info,
     }
@@ -628,42 +690,73 @@ def xilinx(runner: Runner, debian_yosys: str, src_list: str, m: int) -> dict:
     }
 
 
-def ecp5_breakdown(runner: Runner, yosys: str, src_list: str, mods: list[str], mem_modules: list[str]) -> dict:
-    """synth_ecp5 of the bare core with the logic submodules kept as hierarchy.
+ROTATOR = "Rotator"
 
-    Submodules that hold the memories (CoordBuffer) are flattened into the top as in
-    the real run: the memory output register lives in the top, and only a flat view
-    lets Yosys pack it into the DP16KD (kept apart, the memories need extra logic)."""
+
+def ecp5_breakdown(runner: Runner, yosys: str, src_list: str, mods: list[str], mem_modules: list[str],
+                   core_cells: dict[str, int], m: int) -> dict:
+    """Where the core's area goes, from two extra Yosys runs (synthesis only).
+
+    * Rotator: the flat core (the real run minus the wrapper) minus the flat core
+      synthesised with the Rotator black-boxed.  The rotator is not synthesised on
+      its own: alone, ABC9's depth-driven mapping duplicates its log2(m) mux stages
+      into per-output m:1 muxes (O(m^2): 108k LUT4 at m = 32), which the flat design
+      does not do.
+    * ComparatorArray, ResultQueue, AddressSequencer: each synthesised on its own.
+    * Top level + buffers: the rest (flat core minus all of the above); it
+      also absorbs what flattening saves across module boundaries (registers that
+      are equal in two modules are merged in the flat design), so it is a residual.
+    Memory-holding modules (CoordBuffer) stay flattened into the top, as in the real run."""
     texts = {n: t for n, t in module_texts(runner.work, src_list.split()).items()}
     holds_mem = {n for n, t in texts.items() if any(re.search(rf"^\s*{mm}\s+\w+\s*\(", t, re.M) for mm in mem_modules)}
-    subs = [n for n in mods if n != TOP and n not in mem_modules and n not in holds_mem]
-    (runner.work / "breakdown.ys").write_text(
-        f"read_verilog -sv {src_list}\n"
-        f"hierarchy -top {TOP}\n"
-        + (f"setattr -mod -set keep_hierarchy 1 {' '.join(subs)}\n" if subs else "")
-        + f"synth_ecp5 -top {TOP}\n"
-        f"tee -q -o breakdown_stat.json stat -json\n")
+    subs = [n for n in mods if n not in (TOP, ROTATOR) and n not in mem_modules and n not in holds_mem]
+    has_rot = ROTATOR in mods
+    script = [f"read_verilog -sv {src_list}", "design -save sources"]
+    for sub in subs:
+        script += [f"synth_ecp5 -top {sub}", f"tee -q -o breakdown_{sub}.json stat -json", "design -load sources"]
+    script += [f"hierarchy -top {TOP}"] + ([f"blackbox {ROTATOR}"] if has_rot else []) + \
+              [f"synth_ecp5 -top {TOP}", "tee -q -o breakdown_norot.json stat -json"]
+    (runner.work / "breakdown.ys").write_text("\n".join(script) + "\n")
     code, _ = runner.run("yosys breakdown", [yosys, "-q", "-l", "breakdown.log", "-s", "breakdown.ys"],
                          "breakdown.stdout")
     if code != 0:
-        raise FlowError(EXIT_TOOL, "per-module synthesis failed")
-    total, per = stat_cells(runner.work / "breakdown_stat.json")
+        raise FlowError(EXIT_TOOL, "per-part synthesis failed")
+
+    def row(cells: dict[str, int]) -> dict:
+        cells = {k: v for k, v in cells.items() if k not in (ROTATOR, "$scopeinfo")}
+        return {"lut4_slots": comb_cells(cells), "ffs": cells.get("TRELLIS_FF", 0),
+                "dp16kd": cells.get("DP16KD", 0), "ccu2c": cells.get("CCU2C", 0), "cells": cells}
+
+    core = row(core_cells)
+    norot = row(stat_cells(runner.work / "breakdown_norot.json")[0])
     out = {}
-    for name, cells in per.items():
-        cells = {k: v for k, v in cells.items() if k not in subs and k != "$scopeinfo"}
-        label = name if name != TOP else f"{TOP} + {', '.join(sorted(holds_mem))} (top level, memories)"
-        out[label] = {
-            "lut4_slots": comb_cells(cells),
-            "ffs": cells.get("TRELLIS_FF", 0),
-            "dp16kd": cells.get("DP16KD", 0),
-            "ccu2c": cells.get("CCU2C", 0),
-            "cells": cells,
-        }
-    return {"what": "post-synthesis (not placed) ECP5 cells per module of the bare core (no wrapper); "
-                    "lut4_slots = LUT4 + 2*CCU2C; no optimisation across these module boundaries",
-            "kept_modules": subs,
-            "flattened_into_top": sorted(holds_mem),
+    rest = {k: core[k] for k in ("lut4_slots", "ffs", "dp16kd", "ccu2c")}
+    if has_rot:
+        # The rotator is combinational: its registers are in the top level.  (With it
+        # black-boxed, Yosys no longer packs the B-side memory output registers into the
+        # DP16KD, so an FF difference would be meaningless.)
+        out[ROTATOR] = {"lut4_slots": core["lut4_slots"] - norot["lut4_slots"], "ffs": 0, "dp16kd": 0,
+                        "ccu2c": core["ccu2c"] - norot["ccu2c"]}
+        for k in rest:
+            rest[k] -= out[ROTATOR][k]
+    for sub in subs:
+        r = row(stat_cells(runner.work / f"breakdown_{sub}.json")[0])
+        out[sub] = r
+        for k in rest:
+            rest[k] -= r[k]
+    out[f"top level + {', '.join(sorted(holds_mem))} (residual)"] = rest
+    stages = math.ceil(math.log2(m)) if m > 1 else 0
+    return {"what": "post-synthesis (not placed) ECP5 cells per part of the bare core (no wrapper); "
+                    "lut4_slots = LUT4 + 2*CCU2C; see ecp5_breakdown in scripts/fpga/flow.py for the method",
+            "flat_core_synth": {k: core[k] for k in ("lut4_slots", "ffs", "dp16kd", "ccu2c")},
+            "expected": {"rotator_2to1_muxes": 192 * m * stages, "rotator_stages": stages,
+                         "comparators_32bit": 6 * m, "memories": 6 * m},
             "modules": out}
+
+
+def core_synth_cells(ecp5_cells: dict[str, int], wrapper_cells: dict[str, int]) -> dict[str, int]:
+    """Flat ECP5 synthesis cells of the core: the real run minus the wrapper alone."""
+    return {k: v - wrapper_cells.get(k, 0) for k, v in ecp5_cells.items() if k != "$scopeinfo"}
 
 
 def module_texts(work: Path, files: list[str]) -> dict[str, str]:

@@ -1,0 +1,73 @@
+#!/usr/bin/env python3
+"""The FPGA flow end to end on a small configuration (m = 2): a real
+synthesis, place and route, and a report with every field the benchmark and
+the docs rely on. Run by `make test-fpga` (part of `make test`) as
+`python3 scripts/fpga/test_flow.py <verilog-dir>`."""
+import json
+import subprocess
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+VERILOG_DIR: Path
+
+
+class FlowOnSmallConfiguration(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.out = Path(cls.tmp.name) / "m2.json"
+        cls.run = subprocess.run(
+            [sys.executable, str(HERE / "flow.py"), "--verilog-dir", str(VERILOG_DIR), "--m", "2",
+             "--out", str(cls.out), "--work-dir", str(HERE.parent.parent / "build" / "fpga-test-work"),
+             "--no-breakdown"],
+            capture_output=True, text=True)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def report(self):
+        self.assertEqual(self.run.returncode, 0, self.run.stdout[-3000:] + self.run.stderr[-3000:])
+        return json.loads(self.out.read_text())
+
+    def test_places_and_routes_and_reports_a_measured_fmax(self):
+        r = self.report()
+        self.assertEqual(r["status"], "ok")
+        self.assertTrue(r["fits"])
+        self.assertEqual(r["m"], 2)
+        e = r["ecp5"]
+        self.assertGreater(e["fmax_mhz"], 10)
+        self.assertLess(e["fmax_mhz"], 1000)
+        self.assertEqual(e["pair_tests_per_second"], round(2 * e["fmax_mhz"] * 1e6))
+
+    def test_counts_resources_and_keeps_the_memories_in_block_ram(self):
+        r = self.report()
+        e = r["ecp5"]
+        self.assertGreater(e["luts"], 100)
+        self.assertGreater(e["ffs"], 100)
+        # 6 coordinates x 2 lanes, each 256 x 32 bits: at least one DP16KD each.
+        self.assertGreaterEqual(e["bram_dp16kd"], 12)
+        self.assertTrue(r["memories"]["memories_in_bram"])
+        self.assertEqual(r["memories"]["instances"], 12)
+
+    def test_adds_a_xilinx_estimate(self):
+        x = self.report()["xilinx_estimate"]
+        self.assertGreater(x["luts"], 100)
+        self.assertGreater(x["bram_ramb18e1"] + 2 * x["bram_ramb36e1"], 0)
+
+    def test_fails_loudly_on_bad_input(self):
+        with tempfile.TemporaryDirectory() as empty:
+            run = subprocess.run([sys.executable, str(HERE / "flow.py"), "--verilog-dir", empty, "--m", "2",
+                                  "--out", str(Path(empty) / "r.json")], capture_output=True, text=True)
+            self.assertNotEqual(run.returncode, 0)
+            self.assertFalse((Path(empty) / "r.json").exists())
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 2:
+        sys.exit("usage: test_flow.py <verilog-dir with filelist.f for m=2>")
+    VERILOG_DIR = Path(sys.argv.pop(1)).resolve()
+    unittest.main(verbosity=2)
