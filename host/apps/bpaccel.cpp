@@ -88,17 +88,21 @@ int runPairs(const std::string& input, const std::string& backendName, const std
 // Default clock: the Fmax the FPGA flow measured for this configuration, if it ran.
 std::pair<double, std::string> defaultClock(const std::string& fpgaReport) {
   std::ifstream in(fpgaReport);
-  if (in) {
-    try {
-      const auto j = nlohmann::json::parse(in);
-      const double mhz = j.at("fmax_mhz").get<double>();
-      if (j.value("m", 0) == BPACCEL_M && mhz > 0)
-        return {mhz * 1e6, fmt::format("Fmax {:.1f} MHz measured by nextpnr ({})", mhz, fpgaReport)};
-    } catch (const std::exception& e) {
-      fmt::print(stderr, "bpaccel: ignoring FPGA report {}: {}\n", fpgaReport, e.what());
-    }
+  if (!in) return {100e6, "default 100 MHz (no FPGA report at " + fpgaReport + ")"};
+  try {
+    const auto j = nlohmann::json::parse(in);
+    if (j.at("status") != "ok" || !j.at("result_valid").get<bool>())
+      return {100e6, "default 100 MHz (" + fpgaReport + " holds no valid result)"};
+    if (j.at("m").get<int>() != BPACCEL_M)
+      return {100e6, fmt::format("default 100 MHz ({} is for m = {}, not {})", fpgaReport, j.at("m").get<int>(),
+                                 BPACCEL_M)};
+    const double mhz = j.at("ecp5").at("fmax_mhz").get<double>();
+    if (mhz > 0)
+      return {mhz * 1e6, fmt::format("Fmax {:.2f} MHz measured by nextpnr on ECP5 ({})", mhz, fpgaReport)};
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "bpaccel: ignoring FPGA report {}: {}\n", fpgaReport, e.what());
   }
-  return {100e6, "default 100 MHz (no FPGA report at " + fpgaReport + ")"};
+  return {100e6, "default 100 MHz (" + fpgaReport + " unreadable)"};
 }
 
 int runBench(bpaccel::BenchConfig config, const std::vector<std::string>& cells, double clockMHz,

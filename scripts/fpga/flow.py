@@ -300,6 +300,16 @@ def nextpnr_utilisation(text: str) -> dict[str, dict[str, int]]:
     return util
 
 
+def write_wrapper(runner, bins, files, work: Path) -> dict:
+    """Writes fpga_wrapper.v and core_blackbox.v for the top's ports; returns the wrapper's facts."""
+    top_file = next(f for f in files if re.search(rf"^\s*module\s+{TOP}\b", (work / f).read_text(), re.M))
+    ports = top_ports(runner, bins["yosys"], top_file)
+    wrapper_src, wrapper_info = make_wrapper(ports)
+    (work / "fpga_wrapper.v").write_text(wrapper_src)
+    (work / "core_blackbox.v").write_text(blackbox_stub(ports))
+    return wrapper_info
+
+
 # --------------------------------------------------------------------------
 # the flow
 
@@ -370,10 +380,7 @@ def flow(args) -> int:
     src_list = " ".join(files)
 
     # ---- the wrapper
-    ports = top_ports(runner, bins["yosys"], next(f for f in files if re.search(rf"^\s*module\s+{TOP}\b", (work / f).read_text(), re.M)))
-    wrapper_src, wrapper_info = make_wrapper(ports)
-    (work / "fpga_wrapper.v").write_text(wrapper_src)
-    (work / "core_blackbox.v").write_text(blackbox_stub(ports))
+    wrapper_info = write_wrapper(runner, bins, files, work)
 
     # ---- ECP5 synthesis (the design that is placed and routed)
     (work / "ecp5.ys").write_text(
@@ -576,10 +583,7 @@ def update_breakdown(args) -> int:
     bins = ensure_venv(args.venv.resolve())
     runner = Runner(work, time.monotonic() + args.timeout if args.timeout else None)
     yosys = str(bins["yosys"])
-    ports = top_ports(runner, bins["yosys"], next(f for f in files if re.search(rf"^\s*module\s+{TOP}\b", (work / f).read_text(), re.M)))
-    wrapper_src, _ = make_wrapper(ports)
-    (work / "fpga_wrapper.v").write_text(wrapper_src)
-    (work / "core_blackbox.v").write_text(blackbox_stub(ports))
+    write_wrapper(runner, bins, files, work)
     (work / "wrapper.ys").write_text(
         f"read_verilog -sv core_blackbox.v fpga_wrapper.v\n"
         f"synth_ecp5 -top {WRAPPER_TOP}\n"

@@ -43,13 +43,18 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
     dut.io.load.valid.poke(false.B)
   }
 
-  /** Sends start(n) and plays the consumer until done, with `ready(cycle)` as its pattern. */
-  def start(n: Int, ready: Int => Boolean = _ => true): RunOutcome = {
+  /** Sends start(n) for one cycle and returns without waiting for the run. */
+  def pulseStart(n: Int): Unit = {
     dut.io.start.valid.poke(true.B)
     dut.io.start.bits.poke(n.U)
     if (!dut.io.start.ready.peek().litToBoolean) fail("start.ready is low while the accelerator is idle")
     dut.clock.step()
     dut.io.start.valid.poke(false.B)
+  }
+
+  /** Sends start(n) and plays the consumer until done, with `ready(cycle)` as its pattern. */
+  def start(n: Int, ready: Int => Boolean = _ => true): RunOutcome = {
+    pulseStart(n)
 
     val pairs  = Seq.newBuilder[(Int, Int)]
     val probes = Vector.newBuilder[Vector[Option[(Int, Int)]]]

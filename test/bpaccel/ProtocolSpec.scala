@@ -78,10 +78,7 @@ class ProtocolSpec extends AnyFlatSpec with Simulators with Checks {
   "Loading" should "be refused while a run is busy" in {
     withDut { (dut, drv) =>
       drv.load(boxes(16, 7))
-      dut.io.start.valid.poke(true.B)
-      dut.io.start.bits.poke(16.U)
-      dut.clock.step()
-      dut.io.start.valid.poke(false.B)
+      drv.pulseStart(16)
       dut.io.status.busy.expect(true.B)
       dut.io.load.ready.expect(false.B)
       dut.io.start.ready.expect(false.B)
@@ -91,10 +88,7 @@ class ProtocolSpec extends AnyFlatSpec with Simulators with Checks {
   "A reset in the middle of a run" should "leave an idle accelerator that runs the next scene exactly" in {
     withDut { (dut, drv) =>
       drv.load(boxes(16, 8))
-      dut.io.start.valid.poke(true.B)
-      dut.io.start.bits.poke(16.U)
-      dut.clock.step()
-      dut.io.start.valid.poke(false.B)
+      drv.pulseStart(16)
       dut.io.result.ready.poke(true.B)
       dut.clock.step(7)
       dut.io.status.busy.expect(true.B)
