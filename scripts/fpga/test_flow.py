@@ -19,7 +19,7 @@ class FlowOnSmallConfiguration(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.out = Path(cls.tmp.name) / "m2.json"
-        cls.run = subprocess.run(
+        cls.flow = subprocess.run(
             [sys.executable, str(HERE / "flow.py"), "--verilog-dir", str(VERILOG_DIR), "--m", "2",
              "--out", str(cls.out), "--work-dir", str(HERE.parent.parent / "build" / "fpga-test-work"),
              "--no-breakdown"],
@@ -30,7 +30,7 @@ class FlowOnSmallConfiguration(unittest.TestCase):
         cls.tmp.cleanup()
 
     def report(self):
-        self.assertEqual(self.run.returncode, 0, self.run.stdout[-3000:] + self.run.stderr[-3000:])
+        self.assertEqual(self.flow.returncode, 0, self.flow.stdout[-3000:] + self.flow.stderr[-3000:])
         return json.loads(self.out.read_text())
 
     def test_places_and_routes_and_reports_a_measured_fmax(self):
