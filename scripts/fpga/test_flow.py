@@ -41,7 +41,8 @@ class FlowOnSmallConfiguration(unittest.TestCase):
         e = r["ecp5"]
         self.assertGreater(e["fmax_mhz"], 10)
         self.assertLess(e["fmax_mhz"], 1000)
-        self.assertEqual(e["pair_tests_per_second"], round(2 * e["fmax_mhz"] * 1e6))
+        # m x Fmax; the report rounds Fmax to 0.01 MHz, the rate uses nextpnr's full value.
+        self.assertLessEqual(abs(e["pair_tests_per_second"] - 2 * e["fmax_mhz"] * 1e6), 2 * 0.005e6 + 1)
 
     def test_counts_resources_and_keeps_the_memories_in_block_ram(self):
         r = self.report()
