@@ -310,6 +310,20 @@ def write_wrapper(runner, bins, files, work: Path) -> dict:
     return wrapper_info
 
 
+def wrapper_only_cells(runner, yosys: str, work: Path) -> dict:
+    """The wrapper's own cells: the wrapper synthesised around a black-box core."""
+    (work / "wrapper.ys").write_text(
+        f"read_verilog -sv core_blackbox.v fpga_wrapper.v\n"
+        f"synth_ecp5 -top {WRAPPER_TOP}\n"
+        f"tee -q -o wrapper_stat.json stat -json\n")
+    code, _ = runner.run("yosys wrapper-only", [yosys, "-q", "-l", "wrapper.log", "-s", "wrapper.ys"], "wrapper.stdout")
+    if code != 0:
+        raise FlowError(EXIT_TOOL, "synthesis of the wrapper alone failed")
+    wrapper_cells, _ = stat_cells(work / "wrapper_stat.json")
+    wrapper_cells.pop(TOP, None)
+    return wrapper_cells
+
+
 # --------------------------------------------------------------------------
 # the flow
 
@@ -395,15 +409,7 @@ def flow(args) -> int:
     ecp5_memmap = memory_mapping(ytext)
 
     # ---- the wrapper's own cost
-    (work / "wrapper.ys").write_text(
-        f"read_verilog -sv core_blackbox.v fpga_wrapper.v\n"
-        f"synth_ecp5 -top {WRAPPER_TOP}\n"
-        f"tee -q -o wrapper_stat.json stat -json\n")
-    code, _ = runner.run("yosys wrapper-only", [yosys, "-q", "-l", "wrapper.log", "-s", "wrapper.ys"], "wrapper.stdout")
-    if code != 0:
-        raise FlowError(EXIT_TOOL, "synthesis of the wrapper alone failed")
-    wrapper_cells, _ = stat_cells(work / "wrapper_stat.json")
-    wrapper_cells.pop(TOP, None)
+    wrapper_cells = wrapper_only_cells(runner, yosys, work)
 
     # ---- did the memories become block RAM?
     n_mems = 6 * m
@@ -584,15 +590,7 @@ def update_breakdown(args) -> int:
     runner = Runner(work, time.monotonic() + args.timeout if args.timeout else None)
     yosys = str(bins["yosys"])
     write_wrapper(runner, bins, files, work)
-    (work / "wrapper.ys").write_text(
-        f"read_verilog -sv core_blackbox.v fpga_wrapper.v\n"
-        f"synth_ecp5 -top {WRAPPER_TOP}\n"
-        f"tee -q -o wrapper_stat.json stat -json\n")
-    code, _ = runner.run("yosys wrapper-only", [yosys, "-q", "-l", "wrapper.log", "-s", "wrapper.ys"], "wrapper.stdout")
-    if code != 0:
-        raise FlowError(EXIT_TOOL, "synthesis of the wrapper alone failed")
-    wrapper_cells, _ = stat_cells(work / "wrapper_stat.json")
-    wrapper_cells.pop(TOP, None)
+    wrapper_cells = wrapper_only_cells(runner, yosys, work)
     synth = rep["ecp5"]["synth_cells"] if rep["status"] == "ok" else rep["ecp5_demand"]["synth_cells"]
     rep["breakdown_ecp5_synth"] = ecp5_breakdown(runner, yosys, " ".join(files), mods, mem_modules,
                                                  core_synth_cells(synth, wrapper_cells), m)
