@@ -18,7 +18,7 @@ struct HostTimes {
   double treeSeconds = 0;     // k-d tree build
   double cellsSeconds = 0;    // packing, backend runs, decoding and filtering
   double backendSeconds = 0;  // inside Backend::run (simulating the device, or the cpu test itself)
-  double totalSeconds = 0;
+  double totalSeconds = 0;    // all of the above (conversion only when the input was floats)
 };
 
 /// Finds every overlapping pair of a scene exactly once. Without a cell size
