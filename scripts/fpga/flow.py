@@ -470,14 +470,8 @@ def flow(args) -> int:
                     "nextpnr_error": [l for l in ntext.splitlines() if "ERROR" in l][:5],
                     "synth_cells": ecp5_cells,
                 },
-                "memories": memories,
-                "xilinx_estimate": xil,
-                "breakdown_ecp5_synth": breakdown,
-                "runtime_s": dict(runner.runtimes, venv_setup=venv_setup_s,
-                                  total=round(time.monotonic() - t_start, 1)),
             })
-            write_json(out, result)
-            print_summary(result)
+            finish_report(out, result, memories, xil, breakdown, runner, venv_setup_s, t_start)
             return EXIT_NOFIT
         raise FlowError(EXIT_TOOL, "nextpnr-ecp5 failed")
 
@@ -529,15 +523,22 @@ def flow(args) -> int:
                 "note": "placed totals minus the wrapper synthesised alone around a black-box core",
             },
         },
+    })
+    finish_report(out, result, memories, xil, breakdown, runner, venv_setup_s, t_start)
+    return EXIT_OK
+
+
+def finish_report(out: Path, result: dict, memories, xil, breakdown, runner, venv_setup_s: float,
+                  t_start: float) -> None:
+    """Adds the parts every report has (fitting or not), writes it and prints its summary."""
+    result.update({
         "memories": memories,
         "xilinx_estimate": xil,
         "breakdown_ecp5_synth": breakdown,
-        "runtime_s": dict(runner.runtimes, venv_setup=venv_setup_s,
-                          total=round(time.monotonic() - t_start, 1)),
+        "runtime_s": dict(runner.runtimes, venv_setup=venv_setup_s, total=round(time.monotonic() - t_start, 1)),
     })
     write_json(out, result)
     print_summary(result)
-    return EXIT_OK
 
 
 def critical_path(rep: dict, clk_net: str) -> dict | None:
