@@ -8,6 +8,10 @@ debian_packages=(
   verilator g++ cmake ninja-build make pkg-config
   libbullet-dev googletest libgtest-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   python3-venv python3-matplotlib yosys  # plots; the FPGA flow (its PyPI tools go into .venv)
+  libfcl-dev libcgal-dev libode-dev      # the benchmark's peer broad phases
+  libtbb-dev                             # the host's thread pool
+  z3                                     # ChiselTest formal checks
+  clang libclang-rt-14-dev               # libFuzzer and the sanitizers
 )
 
 missing=()

@@ -32,6 +32,7 @@ using Pair = std::pair<std::uint32_t, std::uint32_t>;
 /// What the backends spent on one frame (or one call), summed over all runs.
 struct RunStats {
   std::uint64_t runs = 0;          // accelerator runs (one per cell or chunk pair)
+  std::uint64_t loadCycles = 0;    // hardware cycles spent loading boxes before each start, summed
   std::uint64_t cycles = 0;        // hardware cycles, start to done, summed
   std::uint64_t issueCycles = 0;   // cycles the comparator array had work
   std::uint64_t stallCycles = 0;   // cycles lost to the consumer
@@ -39,8 +40,12 @@ struct RunStats {
   std::uint64_t boxesSent = 0;     // boxes loaded into the accelerator
   std::uint64_t beatsReceived = 0; // result beats read back
 
+  /// Every cycle the device is busy: loading, computing and draining.
+  std::uint64_t deviceCycles() const { return loadCycles + cycles; }
+
   RunStats& operator+=(const RunStats& o) {
     runs += o.runs;
+    loadCycles += o.loadCycles;
     cycles += o.cycles;
     issueCycles += o.issueCycles;
     stallCycles += o.stallCycles;
