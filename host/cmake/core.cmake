@@ -1,0 +1,12 @@
+# bpaccel_core: the host logic that needs no hardware model. Included by the
+# host build (host/CMakeLists.txt) and by the fuzz build (host/fuzz), so the
+# source list lives in one place.
+add_library(bpaccel_core STATIC
+  ${CMAKE_CURRENT_LIST_DIR}/../src/keys.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/../src/box_file.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/../src/backend.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/../src/kd_tree.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/../src/broad_phase.cpp)
+target_include_directories(bpaccel_core PUBLIC ${CMAKE_CURRENT_LIST_DIR}/../src)
+target_link_libraries(bpaccel_core PUBLIC fmt::fmt)
+target_compile_options(bpaccel_core PRIVATE -Wall -Wextra -Wpedantic)
