@@ -11,7 +11,8 @@ namespace bpaccel {
 
 float SceneConfig::cubeEdge() const { return std::cbrt(static_cast<float>(objects) / density); }
 
-BouncingCubeScene::BouncingCubeScene(const SceneConfig& config) : config_(config), edge_(config.cubeEdge()) {
+BouncingCubeScene::BouncingCubeScene(const SceneConfig& config, std::unique_ptr<btBroadphaseInterface> broadphase)
+    : config_(config), edge_(config.cubeEdge()), broadphase_(std::move(broadphase)) {
   if (config.objects == 0) throw std::invalid_argument("scene: at least one object");
   if (!(config.minSize > 0) || !(config.maxSize >= config.minSize))
     throw std::invalid_argument(fmt::format("scene: sizes must satisfy 0 < min <= max, got {} and {}",
@@ -23,7 +24,7 @@ BouncingCubeScene::BouncingCubeScene(const SceneConfig& config) : config_(config
 
   collisionConfig_ = std::make_unique<btDefaultCollisionConfiguration>();
   dispatcher_ = std::make_unique<btCollisionDispatcher>(collisionConfig_.get());
-  broadphase_ = std::make_unique<btDbvtBroadphase>();
+  if (!broadphase_) broadphase_ = std::make_unique<btDbvtBroadphase>();
   solver_ = std::make_unique<btSequentialImpulseConstraintSolver>();
   world_ = std::make_unique<btDiscreteDynamicsWorld>(dispatcher_.get(), broadphase_.get(), solver_.get(),
                                                      collisionConfig_.get());

@@ -7,12 +7,13 @@
 #include <string>
 #include <vector>
 
+#include <BulletCollision/BroadphaseCollision/btBroadphaseInterface.h>
+
 #include "types.hpp"
 
 class btDiscreteDynamicsWorld;
 class btDefaultCollisionConfiguration;
 class btCollisionDispatcher;
-class btBroadphaseInterface;
 class btSequentialImpulseConstraintSolver;
 class btCollisionShape;
 class btRigidBody;
@@ -46,7 +47,8 @@ struct ObjectPose {
 /// restitution 1, so they keep bouncing off each other and the walls.
 class BouncingCubeScene {
  public:
-  explicit BouncingCubeScene(const SceneConfig& config);
+  /// `broadphase` null: btDbvtBroadphase, Bullet's recommended one.
+  explicit BouncingCubeScene(const SceneConfig& config, std::unique_ptr<btBroadphaseInterface> broadphase = nullptr);
   ~BouncingCubeScene();
   BouncingCubeScene(const BouncingCubeScene&) = delete;
   BouncingCubeScene& operator=(const BouncingCubeScene&) = delete;
@@ -59,6 +61,8 @@ class BouncingCubeScene {
   float cubeEdge() const { return edge_; }
   /// Total kinetic energy: stays roughly constant when the walls and contacts are elastic.
   double kineticEnergy() const;
+  /// The world, for callers that inspect contacts or time whole steps.
+  btDiscreteDynamicsWorld& world() { return *world_; }
 
  private:
   SceneConfig config_;

@@ -1,0 +1,263 @@
+#include "bullet_drop_in.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <type_traits>
+
+#include <BulletCollision/BroadphaseCollision/btOverlappingPairCache.h>
+#include <LinearMath/btAabbUtil2.h>
+#include <fmt/format.h>
+
+namespace bpaccel {
+
+// The keys are float32: a double-precision Bullet would round AABBs on the way in.
+static_assert(std::is_same_v<btScalar, float>, "bpaccel::Broadphase needs single-precision Bullet (btScalar = float)");
+
+struct Broadphase::Proxy : btBroadphaseProxy {
+  std::uint32_t slot = 0;   // fixed for the storage's life; orders pair changes
+  std::uint32_t dense = 0;  // index into boxes_ while live
+  bool live = false;
+};
+
+namespace {
+
+// Any uid works for the hashed cache; slot + 2 keeps uid order = slot order
+// (so each cached pair is (lower slot, higher slot)), as btSimpleBroadphase's handle + 2.
+constexpr int kUidOffset = 2;
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+std::string describe(const btBroadphaseProxy* proxy) {
+  if (proxy == nullptr) return "new proxy";
+  return fmt::format("proxy {} (client object {})", proxy->m_uniqueId, fmt::ptr(proxy->m_clientObject));
+}
+
+}  // namespace
+
+Broadphase::Broadphase(std::unique_ptr<Backend> backend, BroadphaseOptions options, btOverlappingPairCache* pairCache)
+    : backend_(std::move(backend)), options_(options), broadPhase_(*backend_, options.cellSize) {
+  if (!backend_) throw BroadphaseError("bpaccel::Broadphase: no backend given");
+  if (options_.maxProxies == 0 || options_.maxProxies > 0xFFFFFFFEull)
+    throw BroadphaseError(fmt::format("bpaccel::Broadphase: maxProxies must be in 1..{}, got {}", 0xFFFFFFFEull,
+                                      options_.maxProxies));
+  if (pairCache == nullptr) ownedCache_ = std::make_unique<btHashedOverlappingPairCache>();
+  cache_ = pairCache != nullptr ? pairCache : ownedCache_.get();
+}
+
+// Like Bullet's broad phases, the pairs of proxies still alive are left in the
+// cache: a world removes its objects (and their pairs) before it drops the broad phase.
+Broadphase::~Broadphase() = default;
+
+Broadphase::Proxy& Broadphase::owned(btBroadphaseProxy* proxy, const char* what) const {
+  if (proxy == nullptr) throw BroadphaseError(fmt::format("{}: null proxy", what));
+  // Only the base class's fields are read before the proxy is known to be ours.
+  const long long slot = static_cast<long long>(proxy->m_uniqueId) - kUidOffset;
+  if (slot < 0 || slot >= static_cast<long long>(slots_.size()) ||
+      slots_[static_cast<std::size_t>(slot)].get() != proxy)
+    throw BroadphaseError(fmt::format("{}: {} was not created by this broad phase", what, describe(proxy)));
+  Proxy& p = *slots_[static_cast<std::size_t>(slot)];
+  if (!p.live) throw BroadphaseError(fmt::format("{}: {} was already destroyed", what, describe(proxy)));
+  return p;
+}
+
+Aabb Broadphase::checkedBox(const btVector3& aabbMin, const btVector3& aabbMax, const Proxy* proxy, const char* what) {
+  static constexpr char kAxis[3] = {'x', 'y', 'z'};
+  Aabb box{};
+  for (int a = 0; a < 3; ++a) {
+    const float lo = aabbMin[a], hi = aabbMax[a];
+    if (std::isnan(lo) || std::isnan(hi))
+      throw BroadphaseError(fmt::format("{}: {} has NaN in its AABB on {} (min {}, max {})", what, describe(proxy),
+                                        kAxis[a], lo, hi));
+    if (lo > hi)
+      throw BroadphaseError(fmt::format("{}: {} has min {} > max {} on {}", what, describe(proxy), lo, hi, kAxis[a]));
+    box.min[static_cast<std::size_t>(a)] = lo;
+    box.max[static_cast<std::size_t>(a)] = hi;
+  }
+  return box;
+}
+
+btBroadphaseProxy* Broadphase::createProxy(const btVector3& aabbMin, const btVector3& aabbMax, int /*shapeType*/,
+                                           void* userPtr, int collisionFilterGroup, int collisionFilterMask,
+                                           btDispatcher* /*dispatcher*/) {
+  if (boxes_.size() >= options_.maxProxies)
+    throw BroadphaseError(fmt::format("createProxy: this broad phase holds at most {} proxies (BroadphaseOptions::maxProxies)",
+                                      options_.maxProxies));
+  const Aabb box = checkedBox(aabbMin, aabbMax, nullptr, "createProxy");
+  std::uint32_t slot;
+  if (!freeSlots_.empty()) {
+    slot = freeSlots_.back();
+    freeSlots_.pop_back();
+  } else {
+    slot = static_cast<std::uint32_t>(slots_.size());
+    slots_.push_back(std::make_unique<Proxy>());
+  }
+  Proxy& p = *slots_[slot];
+  p.m_aabbMin = aabbMin;
+  p.m_aabbMax = aabbMax;
+  p.m_clientObject = userPtr;
+  p.m_collisionFilterGroup = collisionFilterGroup;
+  p.m_collisionFilterMask = collisionFilterMask;
+  p.m_uniqueId = static_cast<int>(slot) + kUidOffset;
+  p.slot = slot;
+  p.dense = static_cast<std::uint32_t>(boxes_.size());
+  p.live = true;
+  boxes_.push_back(box);
+  denseSlot_.push_back(slot);
+  return &p;
+}
+
+void Broadphase::destroyProxy(btBroadphaseProxy* proxy, btDispatcher* dispatcher) {
+  Proxy& p = owned(proxy, "destroyProxy");
+  cache_->removeOverlappingPairsContainingProxy(&p, dispatcher);
+  // Swap-remove from the dense arrays, moving the last box into the hole.
+  const std::uint32_t last = static_cast<std::uint32_t>(boxes_.size() - 1);
+  const std::uint32_t movedSlot = denseSlot_[last];
+  boxes_[p.dense] = boxes_[last];
+  denseSlot_[p.dense] = movedSlot;
+  slots_[movedSlot]->dense = p.dense;
+  boxes_.pop_back();
+  denseSlot_.pop_back();
+  p.live = false;
+  p.m_clientObject = nullptr;
+  freeSlots_.push_back(p.slot);
+}
+
+void Broadphase::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbMin, const btVector3& aabbMax,
+                         btDispatcher* /*dispatcher*/) {
+  Proxy& p = owned(proxy, "setAabb");
+  boxes_[p.dense] = checkedBox(aabbMin, aabbMax, &p, "setAabb");
+  p.m_aabbMin = aabbMin;
+  p.m_aabbMax = aabbMax;
+}
+
+void Broadphase::getAabb(btBroadphaseProxy* proxy, btVector3& aabbMin, btVector3& aabbMax) const {
+  const Proxy& p = owned(proxy, "getAabb");
+  aabbMin = p.m_aabbMin;
+  aabbMax = p.m_aabbMax;
+}
+
+void Broadphase::rayTest(const btVector3& rayFrom, const btVector3& /*rayTo*/, btBroadphaseRayCallback& rayCallback,
+                         const btVector3& aabbMin, const btVector3& aabbMax) {
+  // The callback carries the ray's inverse direction, signs and length, as btDbvtBroadphase uses them.
+  const btScalar lambdaMax = rayCallback.m_lambda_max;
+  for (const auto& slot : slots_) {
+    if (!slot->live) continue;
+    const btVector3 bounds[2] = {slot->m_aabbMin - aabbMax, slot->m_aabbMax - aabbMin};
+    btScalar tmin;
+    if (btRayAabb2(rayFrom, rayCallback.m_rayDirectionInverse, rayCallback.m_signs, bounds, tmin, 0, lambdaMax))
+      rayCallback.process(slot.get());
+  }
+}
+
+void Broadphase::aabbTest(const btVector3& aabbMin, const btVector3& aabbMax, btBroadphaseAabbCallback& callback) {
+  for (const auto& slot : slots_)
+    if (slot->live && TestAabbAgainstAabb2(aabbMin, aabbMax, slot->m_aabbMin, slot->m_aabbMax))
+      callback.process(slot.get());
+}
+
+void Broadphase::calculateOverlappingPairs(btDispatcher* dispatcher) {
+  const auto start = Clock::now();
+  report_ = FrameReport{};
+  report_.proxies = boxes_.size();
+  broadPhase_.findPairs(std::span<const Aabb>(boxes_), found_);
+  report_.overlaps = found_.size();
+  const auto found = Clock::now();
+  report_.findSeconds = std::chrono::duration<double>(found - start).count();
+
+  // Both sets as (lower slot, higher slot), sorted: the backend's pair order
+  // never reaches Bullet, and changes go to the cache in one fixed order.
+  for (Pair& pair : found_) {
+    const std::uint32_t a = denseSlot_[pair.first], b = denseSlot_[pair.second];
+    pair = {std::min(a, b), std::max(a, b)};
+  }
+  std::sort(found_.begin(), found_.end());
+  // The cache itself is the previous frame's set: pairs the world removed (a
+  // destroyed object's) come back while they overlap, as with btSimpleBroadphase.
+  const btBroadphasePairArray& array = cache_->getOverlappingPairArray();
+  cached_.clear();
+  cached_.reserve(static_cast<std::size_t>(array.size()));
+  for (int k = 0; k < array.size(); ++k) {
+    const std::uint32_t a = owned(array[k].m_pProxy0, "pair cache").slot;
+    const std::uint32_t b = owned(array[k].m_pProxy1, "pair cache").slot;
+    cached_.emplace_back(std::min(a, b), std::max(a, b));
+  }
+  std::sort(cached_.begin(), cached_.end());
+
+  // A cache with deferred removal (btSortedOverlappingPairCache) ignores
+  // removeOverlappingPair: the broad phase cleans the ended pairs and compacts
+  // the array itself, as btDbvtBroadphase::performDeferredRemoval does.
+  const bool deferred = cache_->hasDeferredRemoval();
+  ended_.clear();
+  std::size_t i = 0, j = 0;
+  while (i < found_.size() || j < cached_.size()) {
+    if (j == cached_.size() || (i < found_.size() && found_[i] < cached_[j])) {
+      cache_->addOverlappingPair(slots_[found_[i].first].get(), slots_[found_[i].second].get());
+      ++report_.added;
+      ++i;
+    } else if (i == found_.size() || cached_[j] < found_[i]) {
+      if (deferred)
+        ended_.push_back(cached_[j]);
+      else
+        cache_->removeOverlappingPair(slots_[cached_[j].first].get(), slots_[cached_[j].second].get(), dispatcher);
+      ++report_.removed;
+      ++j;
+    } else {
+      ++i;
+      ++j;
+    }
+  }
+  if (deferred) removeDeferred(dispatcher);
+  report_.cacheSeconds = secondsSince(found);
+  report_.totalSeconds = secondsSince(start);
+}
+
+void Broadphase::removeDeferred(btDispatcher* dispatcher) {
+  btBroadphasePairArray& array = cache_->getOverlappingPairArray();
+  int invalid = 0;
+  for (int k = 0; k < array.size(); ++k) {
+    btBroadphasePair& pair = array[k];
+    const std::uint32_t a = owned(pair.m_pProxy0, "pair cache").slot, b = owned(pair.m_pProxy1, "pair cache").slot;
+    if (!std::binary_search(ended_.begin(), ended_.end(), Pair{std::min(a, b), std::max(a, b)})) continue;
+    cache_->cleanOverlappingPair(pair, dispatcher);
+    pair.m_pProxy0 = nullptr;
+    pair.m_pProxy1 = nullptr;
+    ++invalid;
+  }
+  // Bullet's pair order puts the emptied pairs last.
+  array.quickSort(btBroadphasePairSortPredicate());
+  array.resize(array.size() - invalid);
+}
+
+void Broadphase::getBroadphaseAabb(btVector3& aabbMin, btVector3& aabbMax) const {
+  aabbMin.setValue(0, 0, 0);
+  aabbMax.setValue(0, 0, 0);
+  if (boxes_.empty()) return;
+  Aabb all = boxes_.front();
+  for (const Aabb& b : boxes_)
+    for (std::size_t a = 0; a < 3; ++a) {
+      all.min[a] = std::min(all.min[a], b.min[a]);
+      all.max[a] = std::max(all.max[a], b.max[a]);
+    }
+  aabbMin.setValue(all.min[0], all.min[1], all.min[2]);
+  aabbMax.setValue(all.max[0], all.max[1], all.max[2]);
+}
+
+void Broadphase::resetPool(btDispatcher* /*dispatcher*/) {
+  if (!boxes_.empty()) return;
+  slots_.clear();
+  freeSlots_.clear();
+}
+
+void Broadphase::printStats() {
+  const RunStats& s = broadPhase_.stats();
+  fmt::print("bpaccel::Broadphase: backend {} cell size {}, {} proxies, {} cached pairs\n"
+             "  last frame: {} overlaps, {} added, {} removed, find {:.6f} s, cache {:.6f} s\n"
+             "  all frames: {} runs, {} device cycles, {} hits\n",
+             backend_->name(), options_.cellSize ? fmt::format("{}", *options_.cellSize) : std::string("none"),
+             boxes_.size(), cache_->getNumOverlappingPairs(), report_.overlaps, report_.added, report_.removed,
+             report_.findSeconds, report_.cacheSeconds, s.runs, s.deviceCycles(), s.hits);
+}
+
+}  // namespace bpaccel

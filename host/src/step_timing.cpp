@@ -1,0 +1,31 @@
+#include "step_timing.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+
+namespace bpaccel {
+
+double StepTimes::median() const {
+  if (stepSeconds.empty()) throw std::logic_error("StepTimes::median: no frame was timed");
+  std::vector<double> sorted = stepSeconds;
+  const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
+  std::nth_element(sorted.begin(), mid, sorted.end());
+  return *mid;
+}
+
+StepTimes timeWholeSteps(const SceneConfig& scene, const BroadphaseFactory& makeBroadphase, std::size_t frames,
+                         std::size_t warmup) {
+  BouncingCubeScene world(scene, makeBroadphase());
+  for (std::size_t f = 0; f < warmup; ++f) world.step();
+  StepTimes times;
+  times.stepSeconds.reserve(frames);
+  for (std::size_t f = 0; f < frames; ++f) {
+    const auto start = std::chrono::steady_clock::now();
+    world.step();
+    times.stepSeconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  return times;
+}
+
+}  // namespace bpaccel
