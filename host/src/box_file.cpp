@@ -1,7 +1,11 @@
 #include "box_file.hpp"
 
 #include <charconv>
+#include <clocale>
 #include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -15,6 +19,35 @@ ParseError::ParseError(std::size_t line, const std::string& reason)
 namespace {
 
 bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+/// The "C" locale, so strtof reads '.' as the decimal point whatever locale
+/// the program that uses this library has set.
+class CLocale {
+ public:
+  CLocale() : locale_(newlocale(LC_ALL_MASK, "C", locale_t{})) {
+    if (!locale_) throw std::runtime_error("cannot create the C locale");
+  }
+  ~CLocale() { freelocale(locale_); }
+  CLocale(const CLocale&) = delete;
+  CLocale& operator=(const CLocale&) = delete;
+  locale_t get() const { return locale_; }
+
+ private:
+  locale_t locale_;
+};
+
+/// A number from_chars found out of range, rounded exactly as strtof rounds
+/// it: an underflow becomes the nearest denormal or a signed zero. Returns
+/// false for an overflow, which becomes an infinity in strtof.
+bool roundOutOfRange(std::string_view digits, float& value) {
+  static_assert(std::numeric_limits<float>::has_denorm == std::denorm_present);
+  const CLocale c;
+  const std::string text(digits);
+  char* end = nullptr;
+  value = strtof_l(text.c_str(), &end, c.get());
+  if (end != text.c_str() + text.size()) throw std::logic_error("strtof read less than from_chars");
+  return !std::isinf(value);
+}
 
 }  // namespace
 
@@ -42,10 +75,14 @@ std::vector<Aabb> readBoxes(std::istream& in) {
       // from_chars takes no leading '+', which people write; allow one.
       const char* digits = (*p == '+' && tokenEnd - p > 1 && p[1] != '-' && p[1] != '+') ? p + 1 : p;
       const auto [ptr, ec] = std::from_chars(digits, tokenEnd, value);
-      if (ec == std::errc::result_out_of_range)
-        throw ParseError(lineNo, fmt::format("{} '{}' is out of float range", kField[fields], token));
-      if (ec != std::errc() || ptr != tokenEnd)
+      if ((ec != std::errc() && ec != std::errc::result_out_of_range) || ptr != tokenEnd)
         throw ParseError(lineNo, fmt::format("{} '{}' is not a number", kField[fields], token));
+      // from_chars calls underflows out of range too; they are valid coordinates.
+      if (ec == std::errc::result_out_of_range &&
+          !roundOutOfRange(std::string_view(digits, static_cast<std::size_t>(tokenEnd - digits)), value))
+        throw ParseError(lineNo, fmt::format("{} '{}' is beyond the float range (largest magnitude {}); write inf "
+                                             "for an infinite coordinate",
+                                             kField[fields], token, std::numeric_limits<float>::max()));
       if (std::isnan(value)) throw ParseError(lineNo, fmt::format("{} is NaN", kField[fields]));
       v[fields++] = value;
       p = tokenEnd;

@@ -21,7 +21,11 @@ class ParseError : public std::runtime_error {
 };
 
 /// Reads `minx miny minz maxx maxy maxz` lines; blank lines and `#` comments
-/// are skipped. Any malformed line (field count, not a number, NaN,
+/// are skipped. Numbers are rounded to float exactly as C's strtof rounds
+/// them: values too small for a normal float become the nearest denormal or
+/// a signed zero. Values beyond the float range (|x| rounding above
+/// 3.4028235e38) are rejected rather than silently made infinite; `inf` and
+/// `-inf` are written as such. Any malformed line (field count, not a number, NaN,
 /// min > max) throws ParseError with its 1-based line number; nothing is
 /// returned partially.
 std::vector<Aabb> readBoxes(std::istream& in);

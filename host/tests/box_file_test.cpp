@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <sstream>
 
 #include "box_file.hpp"
@@ -17,6 +20,11 @@ std::string errorOf(const std::string& text) {
     return e.what();
   }
   return "accepted";
+}
+
+std::vector<Aabb> boxesOf(const std::string& text) {
+  std::istringstream in(text);
+  return readBoxes(in);
 }
 
 }  // namespace
@@ -45,7 +53,38 @@ TEST(ReadBoxes, RejectsTextThatIsNotANumber) {
   EXPECT_EQ(errorOf("0 0 0 1 x 1\n"), "line 1: maxy 'x' is not a number");
   EXPECT_EQ(errorOf("0 0 0 1 1.5.2 1\n"), "line 1: maxy '1.5.2' is not a number");
   EXPECT_EQ(errorOf("0 0 0 1 1 1,\n"), "line 1: maxz '1,' is not a number");
-  EXPECT_EQ(errorOf("0 0 0 1 1 1e99\n"), "line 1: maxz '1e99' is out of float range");
+}
+
+TEST(ReadBoxes, RoundsUnderflowsAsStrtofDoes) {
+  const float denormMin = std::numeric_limits<float>::denorm_min();
+  // 1e-46 is below half the smallest denormal: zero, with its sign.
+  const auto b = boxesOf("1e-46 -1e-46 6e-46 1 1 8e-46\n-1e-40 1e-40 1e-45 1e-40 1e-40 1e-38\n");
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_EQ(std::bit_cast<std::uint32_t>(b[0].min[0]), 0x00000000u);
+  EXPECT_EQ(std::bit_cast<std::uint32_t>(b[0].min[1]), 0x80000000u);  // -0.0
+  EXPECT_EQ(b[0].min[2], 0.0f);                                       // 6e-46 < denormMin / 2
+  EXPECT_EQ(b[0].max[2], denormMin);                                  // 8e-46 > denormMin / 2
+  // 1e-40 is 71362.38... smallest denormals: the nearest one is 71362 of them.
+  EXPECT_EQ(b[1].min[1], 71362 * denormMin);
+  EXPECT_EQ(b[1].min[0], -71362 * denormMin);
+  EXPECT_EQ(b[1].min[2], denormMin);  // 1e-45 rounds to the smallest denormal
+  EXPECT_EQ(b[1].max[2], 1e-38f);     // a normal float, for comparison
+}
+
+TEST(ReadBoxes, AcceptsTheLargestFloatAndRejectsBeyondItNamingTheField) {
+  const float largest = std::numeric_limits<float>::max();
+  // 3.40282356e38 still rounds to the largest float; 3.4028236e38 rounds past it.
+  const auto b = boxesOf("-3.40282356e38 0 0 3.4028235e38 1 1\n");
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_EQ(b[0].min[0], -largest);
+  EXPECT_EQ(b[0].max[0], largest);
+  EXPECT_EQ(errorOf("0 0 0 1 1 3.4028236e38\n"),
+            "line 1: maxz '3.4028236e38' is beyond the float range (largest magnitude 3.4028235e+38); write inf for "
+            "an infinite coordinate");
+  EXPECT_EQ(errorOf("# x\n-1e99 0 0 1 1 1\n"),
+            "line 2: minx '-1e99' is beyond the float range (largest magnitude 3.4028235e+38); write inf for an "
+            "infinite coordinate");
+  EXPECT_TRUE(std::isinf(boxesOf("-inf 0 0 inf 1 1\n")[0].min[0]));
 }
 
 TEST(ReadBoxes, RejectsNaN) { EXPECT_EQ(errorOf("\n\nnan 0 0 1 1 1\n"), "line 3: minx is NaN"); }
