@@ -2,22 +2,29 @@
 
 #include <algorithm>
 
+#include "keys.hpp"
+
 namespace bpaccel {
 
 void KdTree::build(std::span<const KeyBox> boxes, std::size_t cellSize) {
-  pool_.clear();
+  checkObjectCount(boxes.size());
+  leafItems_.clear();
   leaves_.clear();
   stack_.clear();
   const auto n = static_cast<std::uint32_t>(boxes.size());
-  pool_.resize(n);
-  for (std::uint32_t i = 0; i < n; ++i) pool_[i] = i;
+  work_.resize(n);
+  for (std::uint32_t i = 0; i < n; ++i) work_[i] = i;
   constexpr std::uint64_t kTop = std::uint64_t{1} << 32;
   stack_.push_back({0, n, {0, 0, 0}, {kTop, kTop, kTop}});
   while (!stack_.empty()) {
     const Task task = stack_.back();
     stack_.pop_back();
-    if (task.count <= cellSize || !split(boxes, task))
-      leaves_.push_back({task.begin, task.count, task.lo, task.hi});
+    if (task.count <= cellSize || !split(boxes, task)) {
+      const auto items = work_.begin() + static_cast<std::ptrdiff_t>(task.begin);
+      leaves_.push_back({leafItems_.size(), task.count, task.lo, task.hi});
+      leafItems_.insert(leafItems_.end(), items, items + task.count);
+      work_.resize(task.begin);  // the next node on the stack owns the end again
+    }
   }
 }
 
@@ -31,7 +38,7 @@ bool KdTree::split(std::span<const KeyBox> boxes, const Task& task) {
   const std::uint32_t samples = std::min(kSamples, task.count);
   std::array<std::array<std::uint64_t, kSamples>, 3> centres;  // twice the centre, per axis
   for (std::uint32_t t = 0; t < samples; ++t) {
-    const KeyBox& b = boxes[pool_[task.begin + static_cast<std::uint32_t>(std::uint64_t{t} * task.count / samples)]];
+    const KeyBox& b = boxes[work_[task.begin + std::uint64_t{t} * task.count / samples]];
     for (int a = 0; a < 3; ++a) centres[a][t] = std::uint64_t{b.min[a]} + b.max[a];
   }
   std::array<std::uint64_t, 3> spread{}, lowest{};
@@ -53,33 +60,32 @@ bool KdTree::split(std::span<const KeyBox> boxes, const Task& task) {
     plane = std::max(plane, task.lo[axis] + 1);
     if (plane >= task.hi[axis]) continue;
 
-    // One pass: left children straight onto the pool's end, right ones into
-    // scratch; appended after the left ones only if the split is accepted.
-    const auto leftBegin = static_cast<std::uint32_t>(pool_.size());
-    pool_.resize(pool_.size() + task.count);
+    // One pass: each item goes to the lower child, the upper one or both.
+    left_.resize(task.count);
     right_.resize(task.count);
     std::uint32_t left = 0, right = 0;
     for (std::uint32_t t = 0; t < task.count; ++t) {
-      const std::uint32_t id = pool_[task.begin + t];
+      const std::uint32_t id = work_[task.begin + t];
       const KeyBox& b = boxes[id];
-      pool_[leftBegin + left] = id;
+      left_[left] = id;
       right_[right] = id;
       left += b.min[axis] < plane;
       right += b.max[axis] >= plane;
     }
-    if (left >= task.count || right >= task.count || left + right > task.count + task.count / 4) {
-      pool_.resize(leftBegin);
+    if (left >= task.count || right >= task.count ||
+        std::uint64_t{left} + right > std::uint64_t{task.count} + task.count / 4)
       continue;
-    }
-    pool_.resize(leftBegin + left);
-    pool_.insert(pool_.end(), right_.begin(), right_.begin() + right);
+    // The children replace their parent at the end of the work stack, the
+    // lower one last so that it, popped first, owns the end.
+    work_.resize(task.begin);
+    work_.insert(work_.end(), right_.begin(), right_.begin() + right);
+    work_.insert(work_.end(), left_.begin(), left_.begin() + left);
     Task lower = task, upper = task;
-    lower.begin = leftBegin;
-    lower.count = left;
-    lower.hi[axis] = plane;
-    upper.begin = leftBegin + left;
     upper.count = right;
     upper.lo[axis] = plane;
+    lower.begin = task.begin + right;
+    lower.count = left;
+    lower.hi[axis] = plane;
     stack_.push_back(upper);
     stack_.push_back(lower);
     return true;

@@ -11,14 +11,19 @@
 namespace bpaccel {
 
 /// Built anew every frame; all storage is kept and reused between builds, and
-/// no node allocates. Cells partition key space into half-open boxes
+/// no node allocates. Memory: the leaves' item lists (every box once, plus
+/// one entry per extra leaf a straddling box joins) and a work stack that
+/// holds only the item lists of nodes still waiting to be split, so it never
+/// keeps a whole level, let alone every level. Any object count the input
+/// check accepts (kMaxObjects) can be indexed: lists are addressed with
+/// 64-bit offsets. Cells partition key space into half-open boxes
 /// [lo, hi). A box goes to a child whose region it touches (so a box that
 /// straddles a split plane goes to both), which puts every box that contains
 /// a point p into the one leaf whose region contains p.
 class KdTree {
  public:
   struct Leaf {
-    std::uint32_t begin;               // first item in items()
+    std::uint64_t begin;               // offset of the first item in items()
     std::uint32_t count;               // number of boxes in the cell
     std::array<std::uint64_t, 3> lo;   // region, inclusive
     std::array<std::uint64_t, 3> hi;   // region, exclusive (up to 2^32)
@@ -33,18 +38,26 @@ class KdTree {
   void build(std::span<const KeyBox> boxes, std::size_t cellSize);
 
   const std::vector<Leaf>& leaves() const { return leaves_; }
+  /// Item entries the tree's buffers hold (their capacity): what its memory grows with.
+  std::size_t storedItems() const {
+    return leafItems_.capacity() + work_.capacity() + left_.capacity() + right_.capacity();
+  }
   /// Box indices of a leaf.
-  std::span<const std::uint32_t> items(const Leaf& leaf) const { return {pool_.data() + leaf.begin, leaf.count}; }
+  std::span<const std::uint32_t> items(const Leaf& leaf) const { return {leafItems_.data() + leaf.begin, leaf.count}; }
 
  private:
+  // A node waiting to be split: its items are work_[begin, begin + count),
+  // and the node on top of the stack always owns the end of work_.
   struct Task {
-    std::uint32_t begin, count;
+    std::uint64_t begin;
+    std::uint32_t count;
     std::array<std::uint64_t, 3> lo, hi;
   };
   bool split(std::span<const KeyBox> boxes, const Task& task);
 
-  std::vector<std::uint32_t> pool_;      // item lists of all nodes, appended as built
-  std::vector<std::uint32_t> right_;     // scratch: the upper child's items while splitting
+  std::vector<std::uint32_t> leafItems_;  // item lists of the leaves, in leaf order
+  std::vector<std::uint32_t> work_;       // item lists of the nodes on stack_
+  std::vector<std::uint32_t> left_, right_;  // scratch: the children's items while splitting
   std::vector<Task> stack_;
   std::vector<Leaf> leaves_;
 };

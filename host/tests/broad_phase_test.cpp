@@ -102,6 +102,24 @@ TEST(KdTree, LeavesRespectTheCellSizeWhenSplitsExistAndPartitionSpace) {
   }
 }
 
+TEST(KdTree, MemoryStaysLinearInTheObjectsHoweverDeepTheTree) {
+  // 20,000 small boxes at cell size 2: about 14 levels. Keeping every level's
+  // item lists would hold about n per level; the tree must hold O(n) in all.
+  std::mt19937 gen(4);
+  std::uniform_real_distribution<float> pos(-1000, 1000);
+  std::vector<Aabb> boxes(20000);
+  for (auto& b : boxes) {
+    const float x = pos(gen), y = pos(gen), z = pos(gen);
+    b = box(x, y, z, x + 0.1f, y + 0.1f, z + 0.1f);
+  }
+  std::vector<KeyBox> keys;
+  toKeys(boxes, keys);
+  KdTree tree;
+  tree.build(keys, 2);
+  ASSERT_GT(tree.leaves().size(), 8000u);  // the tree really is deep
+  EXPECT_LE(tree.storedItems(), 8 * keys.size());
+}
+
 TEST(KdTree, ReportsAPairInSeveralLeavesOnlyOnce) {
   // Two big overlapping boxes straddle every plane among many small ones, so
   // they share many leaves; the reference-point rule must keep one copy.
