@@ -5,8 +5,10 @@ add_library(bpaccel_core STATIC
   ${CMAKE_CURRENT_LIST_DIR}/../src/keys.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/box_file.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/backend.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/../src/all_pairs_kernel.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/kd_tree.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/broad_phase.cpp)
 target_include_directories(bpaccel_core PUBLIC ${CMAKE_CURRENT_LIST_DIR}/../src)
-target_link_libraries(bpaccel_core PUBLIC fmt::fmt)
+find_package(TBB REQUIRED)
+target_link_libraries(bpaccel_core PUBLIC fmt::fmt TBB::tbb)
 target_compile_options(bpaccel_core PRIVATE -Wall -Wextra -Wpedantic)

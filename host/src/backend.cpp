@@ -48,26 +48,8 @@ void ModelBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, Ru
 }
 
 void CpuBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) {
-  const std::size_t n = boxes.size();
-  for (int c = 0; c < 6; ++c) soa_[c].resize(n);
-  for (std::size_t i = 0; i < n; ++i)
-    for (int a = 0; a < 3; ++a) {
-      soa_[a][i] = boxes[i].min[a];
-      soa_[3 + a][i] = boxes[i].max[a];
-    }
-  const std::uint32_t *minX = soa_[0].data(), *minY = soa_[1].data(), *minZ = soa_[2].data();
-  const std::uint32_t *maxX = soa_[3].data(), *maxY = soa_[4].data(), *maxZ = soa_[5].data();
   const std::size_t before = out.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t ax0 = minX[i], ay0 = minY[i], az0 = minZ[i];
-    const std::uint32_t ax1 = maxX[i], ay1 = maxY[i], az1 = maxZ[i];
-    for (std::size_t j = i + 1; j < n; ++j) {
-      // Non-short-circuit form so the compiler can evaluate all six at once.
-      const bool hit = (ax0 <= maxX[j]) & (minX[j] <= ax1) & (ay0 <= maxY[j]) & (minY[j] <= ay1) &
-                       (az0 <= maxZ[j]) & (minZ[j] <= az1);
-      if (hit) out.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
-    }
-  }
+  kernel_.run(boxes, out, scratch_);
   stats.runs += 1;
   stats.hits += out.size() - before;
 }

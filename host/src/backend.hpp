@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "all_pairs_kernel.hpp"
 #include "types.hpp"
 
 namespace bpaccel {
@@ -46,16 +47,18 @@ class ModelBackend final : public Backend {
   std::uint64_t overhead_;
 };
 
-/// Software alone: a plain all-pairs test with no capacity limit.
+/// Software alone: all pairs of the batch with SIMD compares (AllPairsKernel),
+/// no capacity limit. One instance per thread: it keeps scratch space.
 class CpuBackend final : public Backend {
  public:
   std::string name() const override { return "cpu"; }
   std::size_t capacity() const override { return std::numeric_limits<std::size_t>::max(); }
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
+  std::string_view isa() const { return kernel_.isa(); }
 
  private:
-  // Structure-of-arrays copy of the batch, reused across calls.
-  std::vector<std::uint32_t> soa_[6];
+  AllPairsKernel kernel_;
+  AllPairsKernel::Scratch scratch_;
 };
 
 }  // namespace bpaccel

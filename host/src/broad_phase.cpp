@@ -4,6 +4,9 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "keys.hpp"
 
@@ -13,15 +16,69 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
-// Which pairs of a two-chunk run to keep (see BroadPhase::processCell).
+// Which pairs of a two-chunk run to keep (see processCell).
 enum Keep : int { kCross = 1, kFirstInside = 2, kSecondInside = 4 };
 
 }  // namespace
 
+/// What one thread needs to process cells: its backend and its buffers.
+struct BroadPhase::Worker {
+  std::unique_ptr<Backend> owned;
+  Backend* backend = nullptr;
+  std::vector<KeyBox> batch;            // a cell's boxes, packed for the backend
+  std::vector<Pair> local;              // pairs of one run, batch indices
+  std::vector<Pair> out;                // this worker's share of the frame's pairs
+  RunStats stats;
+  double backendSeconds = 0;
+
+  void runBatch(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, const KdTree::Leaf* region,
+                std::size_t splitAt, int keep);
+  void processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, const KdTree::Leaf* region,
+                   std::size_t capacity);
+};
+
+/// The threads of a multi-threaded BroadPhase: an arena of its own, so the
+/// thread count is this object's and nothing is shared with other users of TBB.
+class BroadPhase::Pool {
+ public:
+  explicit Pool(std::size_t threads) : arena_(static_cast<int>(threads)) {}
+  template <typename F>
+  void run(F&& f) {
+    arena_.execute(std::forward<F>(f));
+  }
+
+ private:
+  tbb::task_arena arena_;
+};
+
 BroadPhase::BroadPhase(Backend& backend, std::optional<std::size_t> cellSize)
-    : backend_(backend), cellSize_(cellSize) {
+    : cellSize_(cellSize), capacity_(backend.capacity()) {
+  auto w = std::make_unique<Worker>();
+  w->backend = &backend;
+  workers_.push_back(std::move(w));
+  check();
+}
+
+BroadPhase::BroadPhase(const BackendFactory& makeBackend, std::optional<std::size_t> cellSize, std::size_t threads)
+    : cellSize_(cellSize) {
+  if (threads < 1) throw std::invalid_argument("broad phase: at least one thread");
+  for (std::size_t t = 0; t < threads; ++t) {
+    auto w = std::make_unique<Worker>();
+    w->owned = makeBackend();
+    if (!w->owned) throw std::invalid_argument("broad phase: the backend factory gave no backend");
+    w->backend = w->owned.get();
+    workers_.push_back(std::move(w));
+  }
+  capacity_ = workers_.front()->backend->capacity();
+  if (threads > 1) pool_ = std::make_unique<Pool>(threads);
+  check();
+}
+
+BroadPhase::~BroadPhase() = default;
+
+void BroadPhase::check() const {
   if (cellSize_ && *cellSize_ < 1) throw std::invalid_argument("cell size must be at least 1");
-  if (backend_.capacity() < 2) throw std::invalid_argument("backend capacity must be at least 2");
+  if (capacity_ < 2) throw std::invalid_argument("backend capacity must be at least 2");
 }
 
 void BroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) {
@@ -43,30 +100,56 @@ void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out)
     tree_.build(keys, *cellSize_);
     const auto t1 = Clock::now();
     times_.treeSeconds = seconds(t0, t1);
-    for (const KdTree::Leaf& leaf : tree_.leaves()) processCell(keys, tree_.items(leaf), &leaf, out);
+    processCells(keys, out);
     times_.cellsSeconds = seconds(t1, Clock::now());
   } else {
-    identity_.resize(keys.size());
-    std::iota(identity_.begin(), identity_.end(), 0u);
-    processCell(keys, identity_, nullptr, out);
+    processCells(keys, out);
     times_.cellsSeconds = seconds(t0, Clock::now());
   }
   times_.totalSeconds = times_.treeSeconds + times_.cellsSeconds;
+}
+
+void BroadPhase::processCells(std::span<const KeyBox> keys, std::vector<Pair>& out) {
+  for (auto& w : workers_) {
+    w->out.clear();
+    w->stats = {};
+    w->backendSeconds = 0;
+  }
+  if (!cellSize_) {
+    identity_.resize(keys.size());
+    std::iota(identity_.begin(), identity_.end(), 0u);
+    workers_.front()->processCell(keys, identity_, nullptr, capacity_);
+  } else if (!pool_) {
+    for (const KdTree::Leaf& leaf : tree_.leaves()) workers_.front()->processCell(keys, tree_.items(leaf), &leaf, capacity_);
+  } else {
+    const auto& leaves = tree_.leaves();
+    pool_->run([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+        // Inside this arena, thread indices are 0 .. threads-1: one worker each.
+        Worker& w = *workers_.at(static_cast<std::size_t>(tbb::this_task_arena::current_thread_index()));
+        for (std::size_t c = r.begin(); c != r.end(); ++c) w.processCell(keys, tree_.items(leaves[c]), &leaves[c], capacity_);
+      });
+    });
+  }
+  for (auto& w : workers_) {
+    out.insert(out.end(), w->out.begin(), w->out.end());
+    stats_ += w->stats;
+    times_.backendSeconds += w->backendSeconds;
+  }
 }
 
 // A cell within capacity is one run. A larger one is cut into k chunks of at
 // most capacity/2 boxes; chunks p < q run together and keep their cross
 // pairs, and each chunk's inside pairs are kept from exactly one run: chunk
 // p from run (p, p+1), the last chunk from run (k-2, k-1).
-void BroadPhase::processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
-                             const KdTree::Leaf* region, std::vector<Pair>& out) {
-  const std::size_t cap = backend_.capacity();
+void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
+                                     const KdTree::Leaf* region, std::size_t capacity) {
   if (items.size() < 2) return;
-  if (items.size() <= cap) {
-    runBatch(keys, items, region, out, items.size(), kFirstInside);
+  if (items.size() <= capacity) {
+    runBatch(keys, items, region, items.size(), kFirstInside);
     return;
   }
-  const std::size_t chunk = cap / 2;
+  const std::size_t chunk = capacity / 2;
   const std::size_t k = (items.size() + chunk - 1) / chunk;
   std::vector<std::uint32_t> pairItems;  // rare path (cell beyond capacity): allocation is fine here
   for (std::size_t p = 0; p < k; ++p) {
@@ -78,24 +161,24 @@ void BroadPhase::processCell(std::span<const KeyBox> keys, std::span<const std::
       int keep = kCross;
       if (q == p + 1) keep |= kFirstInside;
       if (p == k - 2 && q == k - 1) keep |= kSecondInside;
-      runBatch(keys, pairItems, region, out, first.size(), keep);
+      runBatch(keys, pairItems, region, first.size(), keep);
     }
   }
 }
 
-void BroadPhase::runBatch(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
-                          const KdTree::Leaf* region, std::vector<Pair>& out, std::size_t splitAt, int keep) {
-  batch_.resize(items.size());
-  for (std::size_t t = 0; t < items.size(); ++t) batch_[t] = keys[items[t]];
-  local_.clear();
+void BroadPhase::Worker::runBatch(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
+                                  const KdTree::Leaf* region, std::size_t splitAt, int keep) {
+  batch.resize(items.size());
+  for (std::size_t t = 0; t < items.size(); ++t) batch[t] = keys[items[t]];
+  local.clear();
   const auto t0 = Clock::now();
-  backend_.run(batch_, local_, stats_);
-  times_.backendSeconds += seconds(t0, Clock::now());
-  for (const auto& [a, b] : local_) {
+  backend->run(batch, local, stats);
+  backendSeconds += seconds(t0, Clock::now());
+  for (const auto& [a, b] : local) {
     const bool firstA = a < splitAt, firstB = b < splitAt;
     const int kind = firstA != firstB ? kCross : (firstA ? kFirstInside : kSecondInside);
     if (!(keep & kind)) continue;
-    if (region && !region->contains(referencePoint(batch_[a], batch_[b]))) continue;
+    if (region && !region->contains(referencePoint(batch[a], batch[b]))) continue;
     const std::uint32_t i = items[a], j = items[b];
     out.emplace_back(std::min(i, j), std::max(i, j));
   }

@@ -2,6 +2,8 @@
 // A whole-scene broad phase: keys, optional k-d tree, chunking, backend runs.
 
 #include <chrono>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -17,7 +19,8 @@ struct HostTimes {
   double convertSeconds = 0;  // float to key conversion and validation
   double treeSeconds = 0;     // k-d tree build
   double cellsSeconds = 0;    // packing, backend runs, decoding and filtering
-  double backendSeconds = 0;  // inside Backend::run (simulating the device, or the cpu test itself)
+  double backendSeconds = 0;  // inside Backend::run (simulating the device, or the cpu test itself),
+                              // summed over the worker threads
   double totalSeconds = 0;    // all of the above (conversion only when the input was floats)
 };
 
@@ -25,9 +28,21 @@ struct HostTimes {
 /// the scene is one cell. A cell larger than the backend's capacity is
 /// covered in chunks of capacity/2 boxes: every two chunks run together, and
 /// each pair is kept from exactly one of those runs.
+///
+/// With several threads, the cells are shared out among workers, each with a
+/// backend of its own from the factory (backends keep scratch state and are
+/// not shared between threads); the tree is built on the calling thread.
 class BroadPhase {
  public:
+  using BackendFactory = std::function<std::unique_ptr<Backend>()>;
+
+  /// One thread, on `backend`.
   BroadPhase(Backend& backend, std::optional<std::size_t> cellSize);
+  /// `threads` workers (at least 1), each with its own backend.
+  BroadPhase(const BackendFactory& makeBackend, std::optional<std::size_t> cellSize, std::size_t threads);
+  ~BroadPhase();
+  BroadPhase(const BroadPhase&) = delete;
+  BroadPhase& operator=(const BroadPhase&) = delete;
 
   /// Appends the pairs (i < j, unsorted) to `out` (cleared first).
   void findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out);
@@ -37,20 +52,21 @@ class BroadPhase {
   const RunStats& stats() const { return stats_; }
   const HostTimes& times() const { return times_; }
   const KdTree& tree() const { return tree_; }
+  std::size_t threads() const { return workers_.size(); }
 
  private:
-  void processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, const KdTree::Leaf* region,
-                   std::vector<Pair>& out);
-  void runBatch(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, const KdTree::Leaf* region,
-                std::vector<Pair>& out, std::size_t splitAt, int keepMode);
+  struct Worker;
+  class Pool;
+  void processCells(std::span<const KeyBox> keys, std::vector<Pair>& out);
+  void check() const;
 
-  Backend& backend_;
+  std::vector<std::unique_ptr<Worker>> workers_;
+  std::unique_ptr<Pool> pool_;  // only with more than one worker
   std::optional<std::size_t> cellSize_;
+  std::size_t capacity_;
   KdTree tree_;
   std::vector<KeyBox> keys_;
-  std::vector<KeyBox> batch_;           // a cell's boxes, packed for the backend
-  std::vector<std::uint32_t> identity_; // 0..n-1: the scene as one cell
-  std::vector<Pair> local_;             // pairs of one run, batch indices
+  std::vector<std::uint32_t> identity_;  // 0..n-1: the scene as one cell
   RunStats stats_;
   HostTimes times_;
 };

@@ -3,6 +3,7 @@
 #include <optional>
 #include <set>
 
+#include "all_pairs_kernel.hpp"
 #include "backend.hpp"
 #include "broad_phase.hpp"
 #include "bpaccel_params.h"
@@ -166,4 +167,46 @@ TEST(ScheduleIssueCycles, MatchesThePlainSumOverBlocks) {
       for (std::uint64_t b = 0; n >= 2 && b * m <= n - 2; ++b) sum += n - 1 - b * m;
       ASSERT_EQ(scheduleIssueCycles(n, m), sum) << "m=" << m << " n=" << n;
     }
+}
+
+TEST(AllPairsKernel, SimdGivesTheScalarPairsInTheSameOrderForEverySize) {
+  const AllPairsKernel simd, scalar = AllPairsKernel::scalar();
+  AllPairsKernel::Scratch scratch;
+  std::vector<std::size_t> sizes;
+  for (std::size_t n = 0; n <= 40; ++n) sizes.push_back(n);  // every remainder modulo the vector width
+  sizes.push_back(257);
+  for (std::size_t n : sizes)
+    for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 3)) {
+      std::vector<KeyBox> keys;
+      toKeys(boxes, keys);
+      std::vector<Pair> fromSimd, fromScalar;
+      simd.run(keys, fromSimd, scratch);
+      scalar.run(keys, fromScalar, scratch);
+      const std::string label = name + " n=" + std::to_string(n) + " isa " + std::string(simd.isa());
+      EXPECT_EQ(fromSimd, fromScalar) << label;
+      EXPECT_EQ(fromScalar, bruteForce(boxes)) << label;  // i then j order is the brute force's order
+    }
+}
+
+TEST(BroadPhase, SeveralThreadsGiveExactlyTheSinglePairs) {
+  for (std::size_t threads : {2u, 3u}) {
+    BroadPhase cpu([] { return std::make_unique<CpuBackend>(); }, 8, threads);
+    // A small capacity: cells above it are chunked inside the workers.
+    BroadPhase model([] { return std::make_unique<ModelBackend>(2, 6, 5); }, 16, threads);
+    EXPECT_EQ(cpu.threads(), threads);
+    for (std::size_t n : {0u, 2u, 300u, 1000u})
+      for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 7)) {
+        const auto exact = bruteForce(boxes);
+        std::vector<Pair> pairs;
+        cpu.findPairs(boxes, pairs);
+        EXPECT_EQ(sorted(pairs), exact) << name << " cpu threads " << threads;
+        model.findPairs(boxes, pairs);
+        EXPECT_EQ(sorted(pairs), exact) << name << " model threads " << threads;
+      }
+  }
+}
+
+TEST(BroadPhase, RejectsZeroThreadsAndAnEmptyFactory) {
+  EXPECT_THROW(BroadPhase([] { return std::make_unique<CpuBackend>(); }, 8, 0), std::invalid_argument);
+  EXPECT_THROW(BroadPhase([] { return std::unique_ptr<Backend>(); }, 8, 2), std::invalid_argument);
 }
