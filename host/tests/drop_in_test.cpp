@@ -595,6 +595,20 @@ TEST(DropIn, RayAndBoxQueriesAgreeWithDbvt) {
   }
 }
 
+TEST(DropIn, PrintStatsNamesBackendProxiesAndPairs) {
+  Fixture fx;
+  Broadphase bp(makeBackend("model"), {16});
+  box(bp, fx, 0, 1);
+  box(bp, fx, 0.5f, 2);
+  box(bp, fx, 5, 6);
+  bp.calculateOverlappingPairs(&fx.dispatcher);
+  ::testing::internal::CaptureStdout();
+  bp.printStats();
+  const std::string text = ::testing::internal::GetCapturedStdout();
+  EXPECT_NE(text.find("backend model cell size 16, 3 proxies, 1 cached pairs"), std::string::npos) << text;
+  EXPECT_NE(text.find("1 overlaps, 1 added, 0 removed"), std::string::npos) << text;
+}
+
 TEST(DropIn, WholeStepTimingStepsTheBouncingCube) {
   bpaccel::SceneConfig scene;
   scene.objects = 100;
