@@ -40,6 +40,7 @@ void ModelBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, Ru
   }
   const std::uint64_t issue = scheduleIssueCycles(n, m_);
   stats.runs += 1;
+  stats.loadCycles += n + 1;  // one box a cycle, then the start cycle
   stats.issueCycles += issue;
   stats.cycles += n < 2 ? 0 : issue + overhead_;
   stats.hits += out.size() - before;

@@ -32,8 +32,9 @@ class Backend {
 std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m);
 
 /// Fast C++ model of the accelerator: the same schedule, pairs and cycle
-/// count as the RTL with a consumer that never stalls, for any n up to its
-/// capacity and at software speed.
+/// counts (loads included) as the RTL driven by a host that loads one box a
+/// cycle and a consumer that never stalls, for any n up to its capacity and
+/// at software speed.
 class ModelBackend final : public Backend {
  public:
   ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles);

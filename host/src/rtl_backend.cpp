@@ -85,6 +85,20 @@ void RtlBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunS
   const std::size_t n = boxes.size();
   if (n > capacity())
     throw std::length_error(fmt::format("rtl: {} boxes exceed the hardware capacity {}", n, capacity()));
+  const std::size_t before = out.size();
+  try {
+    runOnHardware(boxes, out, stats);
+  } catch (...) {
+    // A hang or a hardware error leaves the device mid-run: reset it so the
+    // next batch starts from an idle accelerator, and drop this run's partial pairs.
+    reset();
+    out.resize(before);
+    throw;
+  }
+}
+
+void RtlBackend::runOnHardware(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) {
+  const std::size_t n = boxes.size();
   VBroadPhaseAccel& top = *top_;
 
   for (const KeyBox& b : boxes) {
@@ -134,6 +148,7 @@ void RtlBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunS
     throw std::runtime_error(fmt::format("rtl: hardware counted {} hits but {} pairs arrived",
                                          top.io_counters_hits, out.size() - before));
   stats.runs += 1;
+  stats.loadCycles += top.io_counters_loadCycles;
   stats.cycles += top.io_counters_cycles;
   stats.issueCycles += top.io_counters_issueCycles;
   stats.stallCycles += top.io_counters_stallCycles;

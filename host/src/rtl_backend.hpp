@@ -27,6 +27,8 @@ class RtlBackend final : public Backend {
 
   std::string name() const override { return "rtl"; }
   std::size_t capacity() const override;
+  /// On any failure (a hang, a hardware error) the device is reset before the
+  /// exception leaves, so the next run starts from an idle accelerator.
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
 
   static std::size_t lanes();
@@ -36,6 +38,7 @@ class RtlBackend final : public Backend {
   void settle();  // evaluate combinational outputs for the current inputs
   void tick();    // one rising clock edge
   void reset();
+  void runOnHardware(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats);
 
   std::unique_ptr<VerilatedContext> context_;
   std::unique_ptr<VBroadPhaseAccel> top_;

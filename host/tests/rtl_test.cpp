@@ -1,3 +1,4 @@
+#include <gtest/gtest-spi.h>
 #include <gtest/gtest.h>
 
 #include <random>
@@ -20,6 +21,35 @@ std::vector<KeyBox> keysOf(const std::vector<Aabb>& boxes) {
   return keys;
 }
 
+// One batch run on the hardware and on the model.
+struct BothRuns {
+  std::vector<Pair> fromRtl, fromModel;
+  RunStats rtlStats, modelStats;
+};
+
+BothRuns runBoth(Backend& rtl, Backend& model, const std::vector<Aabb>& boxes) {
+  const auto keys = keysOf(boxes);
+  BothRuns r;
+  rtl.run(keys, r.fromRtl, r.rtlStats);
+  model.run(keys, r.fromModel, r.modelStats);
+  return r;
+}
+
+// One run of the hardware against the model and the brute-force reference.
+void expectSameRun(const std::string& label, const std::vector<Aabb>& boxes, const BothRuns& r) {
+  const auto& [fromRtl, fromModel, rtlStats, modelStats] = r;
+  const std::size_t n = boxes.size();
+  EXPECT_EQ(fromRtl, fromModel) << label;  // same pairs, in the same order
+  EXPECT_EQ(sorted(fromRtl), bruteForce(boxes)) << label;
+  EXPECT_EQ(rtlStats.loadCycles, modelStats.loadCycles) << label;
+  EXPECT_EQ(rtlStats.loadCycles, n + 1) << label;  // one box a cycle, then the start
+  EXPECT_EQ(rtlStats.cycles, modelStats.cycles) << label;
+  EXPECT_EQ(rtlStats.beatsReceived, modelStats.beatsReceived) << label;
+  EXPECT_EQ(rtlStats.issueCycles, scheduleIssueCycles(n, BPACCEL_M)) << label;
+  EXPECT_EQ(rtlStats.cycles, n < 2 ? 0 : scheduleIssueCycles(n, BPACCEL_M) + BPACCEL_RUN_OVERHEAD_CYCLES) << label;
+  EXPECT_EQ(rtlStats.stallCycles, 0u) << label;
+}
+
 }  // namespace
 
 TEST(RtlBackend, AgreesWithTheModelOnPairsCyclesAndBeats) {
@@ -31,38 +61,66 @@ TEST(RtlBackend, AgreesWithTheModelOnPairsCyclesAndBeats) {
   for (int t = 0; t < 12; ++t) sizes.push_back(rng() % 400);
   for (std::size_t n : sizes)
     for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n))) {
-      const auto keys = keysOf(boxes);
-      std::vector<Pair> fromRtl, fromModel;
-      RunStats rtlStats, modelStats;
-      rtl.run(keys, fromRtl, rtlStats);
-      model.run(keys, fromModel, modelStats);
-      const std::string label = name + " n=" + std::to_string(n);
-      EXPECT_EQ(fromRtl, fromModel) << label;  // same pairs, in the same order
-      EXPECT_EQ(sorted(fromRtl), bruteForce(boxes)) << label;
-      EXPECT_EQ(rtlStats.cycles, modelStats.cycles) << label;
-      EXPECT_EQ(rtlStats.beatsReceived, modelStats.beatsReceived) << label;
-      EXPECT_EQ(rtlStats.issueCycles, scheduleIssueCycles(n, BPACCEL_M)) << label;
-      EXPECT_EQ(rtlStats.cycles, n < 2 ? 0 : scheduleIssueCycles(n, BPACCEL_M) + BPACCEL_RUN_OVERHEAD_CYCLES)
-          << label;
-      EXPECT_EQ(rtlStats.stallCycles, 0u) << label;
-      if (n <= 400) break;  // the full-capacity case runs one scene only
+      expectSameRun(name + " n=" + std::to_string(n), boxes, runBoth(rtl, model, boxes));
+      if (n > 400) break;  // the full-capacity case runs one scene only
     }
+}
+
+TEST(RtlBackend, TheComparisonCatchesAWrongPairAndAWrongCount) {
+  // The same comparison as above must fail when one pair or one count is off.
+  RtlBackend rtl;
+  ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+  const auto boxes = adversarialScenes(40, 3).at(1).second;  // clusters: many hits
+  const BothRuns runs = runBoth(rtl, model, boxes);
+  ASSERT_FALSE(runs.fromRtl.empty());
+  expectSameRun("untampered", boxes, runs);
+  // Failures reported while `body` runs, caught rather than failing this test.
+  const auto failuresOf = [](auto body) {
+    ::testing::TestPartResultArray failures;
+    {
+      ::testing::ScopedFakeTestPartResultReporter catcher(
+          ::testing::ScopedFakeTestPartResultReporter::INTERCEPT_ONLY_CURRENT_THREAD, &failures);
+      body();
+    }
+    return failures.size();
+  };
+  auto wrongPair = runs;
+  wrongPair.fromRtl.back().second ^= 1u;
+  EXPECT_GE(failuresOf([&] { expectSameRun("tampered pair", boxes, wrongPair); }), 1);
+  auto wrongLoads = runs;
+  wrongLoads.rtlStats.loadCycles += 1;
+  EXPECT_GE(failuresOf([&] { expectSameRun("tampered loads", boxes, wrongLoads); }), 1);
 }
 
 TEST(RtlBackend, StallingConsumerLosesNoPairAndCountsTheStalls) {
   std::mt19937 pattern(5);
   RtlBackend rtl([&](std::uint64_t) { return pattern() % 4 == 0; });
   ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+  std::uint64_t stalls = 0;
   for (const auto& [name, boxes] : adversarialScenes(300, 77)) {
-    const auto keys = keysOf(boxes);
-    std::vector<Pair> fromRtl, fromModel;
-    RunStats rtlStats, modelStats;
-    rtl.run(keys, fromRtl, rtlStats);
-    model.run(keys, fromModel, modelStats);
+    const auto [fromRtl, fromModel, rtlStats, modelStats] = runBoth(rtl, model, boxes);
     EXPECT_EQ(fromRtl, fromModel) << name;
+    stalls += rtlStats.stallCycles;
     EXPECT_EQ(rtlStats.cycles, rtlStats.issueCycles + rtlStats.stallCycles + BPACCEL_RUN_OVERHEAD_CYCLES) << name;
     EXPECT_EQ(rtlStats.issueCycles, scheduleIssueCycles(300, BPACCEL_M)) << name;
+    EXPECT_EQ(rtlStats.loadCycles, modelStats.loadCycles) << name;
   }
+  EXPECT_GT(stalls, 0u);  // the consumer really held the hardware back (sparse scenes have too few beats to)
+}
+
+TEST(RtlBackend, RecoversAfterAHungRunAndRunsTheNextBatchExactly) {
+  bool consumerStuck = true;  // a consumer that never takes a beat hangs the run
+  RtlBackend rtl([&](std::uint64_t) { return !consumerStuck; });
+  ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+  const auto dense = adversarialScenes(60, 9).at(1).second;  // clusters: a hit the consumer never takes
+  std::vector<Pair> pairs;
+  RunStats stats;
+  EXPECT_THROW(rtl.run(keysOf(dense), pairs, stats), std::runtime_error);
+  EXPECT_TRUE(pairs.empty());  // no partial answer is left behind
+  EXPECT_EQ(stats.runs, 0u);
+  consumerStuck = false;
+  for (const auto& [name, boxes] : adversarialScenes(50, 10))
+    expectSameRun("after the hang: " + name, boxes, runBoth(rtl, model, boxes));
 }
 
 TEST(RtlBackend, IsExactThroughTheKdTreeAndAcrossChunks) {

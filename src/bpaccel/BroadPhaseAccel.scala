@@ -49,6 +49,12 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   val overflow = RegInit(false.B)
 
   val cycles      = RegInit(0.U(p.counterWidth.W))
+  // Load cycles of the run being loaded: from its first accepted box to the
+  // cycle that accepts its start, gaps included, since the device belongs to
+  // that run from its first box on. Published in loadCycles at the start.
+  val loading       = RegInit(false.B)
+  val loadingCycles = RegInit(0.U(p.counterWidth.W))
+  val loadCycles    = RegInit(0.U(p.counterWidth.W))
   val issueCycles = RegInit(0.U(p.counterWidth.W))
   val stallCycles = RegInit(0.U(p.counterWidth.W))
   val hits        = RegInit(0.U(p.counterWidth.W))
@@ -79,6 +85,13 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
     }
   }
 
+  when(io.load.fire && !loading) {
+    loading       := true.B
+    loadingCycles := 1.U
+  }.elsewhen(loading) {
+    loadingCycles := loadingCycles + 1.U
+  }
+
   // ---- starting ----
   sequencer.io.start.valid := false.B
   sequencer.io.start.bits  := io.start.bits
@@ -89,6 +102,8 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
     loadRow     := 0.U
     overflow    := false.B
     cycles      := 0.U
+    loadCycles  := Mux(loading, loadingCycles + 1.U, 1.U) // + the start cycle itself
+    loading     := false.B
     issueCycles := 0.U
     stallCycles := 0.U
     hits        := 0.U
@@ -215,6 +230,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   io.info.keyWidth          := p.keyWidth.U
   io.info.runOverheadCycles := p.runOverheadCycles.U
 
+  io.counters.loadCycles  := loadCycles
   io.counters.cycles      := cycles
   io.counters.issueCycles := issueCycles
   io.counters.stallCycles := stallCycles

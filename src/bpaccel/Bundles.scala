@@ -42,6 +42,7 @@ class AccelStatus(p: AccelParams) extends Bundle {
 }
 
 class AccelCounters(p: AccelParams) extends Bundle {
+  val loadCycles  = UInt(p.counterWidth.W) // first box loaded .. start accepted, both included (1 if no box)
   val cycles      = UInt(p.counterWidth.W) // start accepted .. done
   val issueCycles = UInt(p.counterWidth.W) // cycles the comparator array was given work
   val stallCycles = UInt(p.counterWidth.W) // cycles the sequencer waited on the result queue

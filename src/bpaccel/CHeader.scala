@@ -35,7 +35,12 @@ object CHeader {
        | * A run of n >= 2 objects with a consumer that never stalls takes
        | * issue_cycles(n) + BPACCEL_RUN_OVERHEAD_CYCLES cycles, where
        | * issue_cycles(n) = sum over b = 0 .. (n-2)/M of (n - 1 - b*M);
-       | * runs with n < 2 take no cycles. */
+       | * runs with n < 2 take no cycles.
+       | * Counters: load_cycles counts the cycles from a run's first accepted box
+       | * to the cycle that accepts its start, both included (n + 1 when the
+       | * host loads one box a cycle and starts at once; 1 with no box);
+       | * cycles counts from the cycle after the start to done. A run keeps the
+       | * device busy for load_cycles + cycles. */
        |
        |#endif /* BPACCEL_PARAMS_H */
        |""".stripMargin

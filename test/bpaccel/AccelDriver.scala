@@ -9,22 +9,35 @@ case class RunOutcome(
   pairs: Seq[(Int, Int)],                     // every pair of every beat, in arrival order
   probeCycles: Vector[Vector[Option[(Int, Int)]]], // per scheduled cycle, per lane (debug port only)
   error: Int,
+  loadCycles: Long,
   cycles: Long,
   issueCycles: Long,
   stallCycles: Long,
-  hits: Long
+  hits: Long,
+  driverLoadCycles: Long, // clock steps the driver saw from the run's first load to its start, both included
+  driverCycles: Long      // clock steps the driver saw the accelerator busy after the start
 )
 
 /** Drives a [[BroadPhaseAccel]] through its ports, one clock at a time. */
 class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
   private val p = dut.p
   dut.clock.setTimeout(0)
+  // Steps since the first box of the run being loaded (None before its first box).
+  private var loadSteps: Option[Long] = None
+
+  private def step(): Unit = {
+    dut.clock.step()
+    loadSteps = loadSteps.map(_ + 1)
+  }
 
   def idleInputs(): Unit = {
     dut.io.load.valid.poke(false.B)
     dut.io.start.valid.poke(false.B)
     dut.io.result.ready.poke(false.B)
   }
+
+  /** Lets `cycles` clock cycles pass with every input idle. */
+  def idle(cycles: Int): Unit = for (_ <- 0 until cycles) step()
 
   def load(boxes: Seq[Box]): Unit = {
     for (b <- boxes) {
@@ -35,26 +48,30 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
       }
       var waited = 0
       while (!dut.io.load.ready.peek().litToBoolean) {
-        dut.clock.step(); waited += 1
+        step(); waited += 1
         if (waited > 100) fail("load.ready stayed low for 100 cycles while idle")
       }
-      dut.clock.step()
+      if (loadSteps.isEmpty) loadSteps = Some(0)
+      step()
     }
     dut.io.load.valid.poke(false.B)
   }
 
   /** Sends start(n) for one cycle and returns without waiting for the run. */
-  def pulseStart(n: Int): Unit = {
+  def pulseStart(n: Int): Long = {
     dut.io.start.valid.poke(true.B)
     dut.io.start.bits.poke(n.U)
     if (!dut.io.start.ready.peek().litToBoolean) fail("start.ready is low while the accelerator is idle")
-    dut.clock.step()
+    step()
     dut.io.start.valid.poke(false.B)
+    val loadCycles = loadSteps.getOrElse(1L)
+    loadSteps = None
+    loadCycles
   }
 
   /** Sends start(n) and plays the consumer until done, with `ready(cycle)` as its pattern. */
   def start(n: Int, ready: Int => Boolean = _ => true): RunOutcome = {
-    pulseStart(n)
+    val driverLoadCycles = pulseStart(n)
 
     val pairs  = Seq.newBuilder[(Int, Int)]
     val probes = Vector.newBuilder[Vector[Option[(Int, Int)]]]
@@ -87,10 +104,13 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
       pairs.result(),
       probes.result(),
       dut.io.status.error.peek().litValue.toInt,
+      dut.io.counters.loadCycles.peek().litValue.toLong,
       dut.io.counters.cycles.peek().litValue.toLong,
       dut.io.counters.issueCycles.peek().litValue.toLong,
       dut.io.counters.stallCycles.peek().litValue.toLong,
-      dut.io.counters.hits.peek().litValue.toLong
+      dut.io.counters.hits.peek().litValue.toLong,
+      driverLoadCycles,
+      cycle.toLong
     )
   }
 

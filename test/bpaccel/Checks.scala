@@ -16,6 +16,10 @@ trait Checks extends Matchers {
     out.pairs.toSet shouldBe Box.bruteForcePairs(boxes) // nothing missed, nothing extra
     out.hits shouldBe out.pairs.length.toLong
     out.issueCycles shouldBe Schedule.issueCycles(n, p.m)
+    // The hardware's counters against the clock steps the driver itself saw.
+    out.cycles shouldBe out.driverCycles
+    out.loadCycles shouldBe out.driverLoadCycles
+    out.loadCycles shouldBe n + 1L // the driver loads one box a cycle, then starts
     val overhead = if (n < 2) 0 else p.runOverheadCycles
     out.cycles shouldBe out.issueCycles + out.stallCycles + overhead
     if (consumerNeverStalls) out.stallCycles shouldBe 0

@@ -75,6 +75,20 @@ class ProtocolSpec extends AnyFlatSpec with Simulators with Checks {
     }
   }
 
+  "The load-cycle counter" should "count from the first box to the start, pauses included" in {
+    withDut { (_, drv) =>
+      drv.load(boxes(3, 10))
+      drv.idle(5) // the host pauses: the device still belongs to this run
+      drv.load(boxes(2, 11))
+      val out = drv.start(5)
+      out.loadCycles shouldBe 3 + 5 + 2 + 1
+      out.loadCycles shouldBe out.driverLoadCycles
+      // A start with nothing loaded costs its own cycle only.
+      drv.idle(4)
+      drv.start(0).loadCycles shouldBe 1
+    }
+  }
+
   "Loading" should "be refused while a run is busy" in {
     withDut { (dut, drv) =>
       drv.load(boxes(16, 7))

@@ -6,7 +6,7 @@ import org.scalatest.flatspec.AnyFlatSpec
 import scala.util.Random
 
 /** The generated sequencer, rotator and pipeline against the seed's golden
-  * schedule, cycle by cycle and lane by lane, on the Scala simulator.
+  * schedule, cycle by cycle and lane by lane, on Verilator.
   */
 class ScheduleHardwareSpec extends AnyFlatSpec with Simulators with Checks {
 

@@ -8,9 +8,9 @@ import org.scalatest.TestSuite
 
 /** How the specs simulate the accelerator.
   *
-  * Verilator simulates the emitted design itself and runs thousands of times
-  * faster than ChiselTest's default Scala simulator (measured here: 0.04 s
-  * against 5.2 s for the same 120-cycle run at m = 8), so most specs use it;
+  * Verilator simulates the emitted design itself and runs about a hundred
+  * times faster than ChiselTest's default Scala simulator (measured here:
+  * 0.04 s against 5.2 s for the same 120-cycle run at m = 8), so most specs use it;
   * `DefaultSimulatorSpec` keeps a smaller share on the default simulator. A
   * compiled model is cached per suite and configuration, so several tests of
   * one configuration build it once.
