@@ -61,8 +61,10 @@ bool KdTree::split(std::span<const KeyBox> boxes, const Task& task) {
     if (plane >= task.hi[axis]) continue;
 
     // One pass: each item goes to the lower child, the upper one or both.
-    left_.resize(task.count);
-    right_.resize(task.count);
+    if (left_.size() < task.count) {  // grow only: shrinking and growing again would clear them at every node
+      left_.resize(task.count);
+      right_.resize(task.count);
+    }
     std::uint32_t left = 0, right = 0;
     for (std::uint32_t t = 0; t < task.count; ++t) {
       const std::uint32_t id = work_[task.begin + t];
