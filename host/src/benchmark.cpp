@@ -4,25 +4,24 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
-#include <memory>
+#include <map>
+#include <numeric>
+#include <random>
 #include <thread>
 
 #include <fmt/format.h>
 
-#include "backend.hpp"
-#include "bpaccel_params.h"
-#include "broad_phase.hpp"
 #include "bullet_broadphase.hpp"
 #include "exact_pairs.hpp"
-#include "rtl_backend.hpp"
+#include "peers/cgal_box_intersection.hpp"
+#include "peers/fcl_managers.hpp"
+#include "peers/ode_spaces.hpp"
 
 namespace bpaccel {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-std::string cellName(const std::optional<std::size_t>& c) { return c ? std::to_string(*c) : "none"; }
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -38,9 +37,6 @@ nlohmann::json summary(const std::vector<double>& v, double scale) {
           {"max", *std::max_element(v.begin(), v.end()) * scale}};
 }
 
-// Bytes of one result beat: {iBase, jBase, mask[m]}, rounded up to bytes.
-std::size_t beatBytes() { return (2 * BPACCEL_INDEX_WIDTH + BPACCEL_M + 7) / 8; }
-
 std::string machineDescription() {
   std::ifstream cpuinfo("/proc/cpuinfo");
   std::string line;
@@ -49,12 +45,28 @@ std::string machineDescription() {
   return "unknown";
 }
 
+// One method of one row: its spec, the built method (or why it was skipped) and its samples.
+struct Entry {
+  const MethodSpec* spec = nullptr;
+  std::unique_ptr<TimedMethod> method;
+  std::optional<std::string> skipped;
+  double setupSeconds = 0, updateSeconds = 0;
+  std::vector<double> frameSeconds, hostSeconds, deviceSeconds, transferSeconds;
+  std::vector<double> deviceCycles, loadCycles, cycles, runs, boxesSent;
+  std::uint64_t missing = 0, extra = 0;  // against the exact set, over every frame (warm-up included)
+  std::uint64_t duplicates = 0;          // pairs reported more than once
+};
+
+bool isBaseline(MethodKind k) { return k == MethodKind::Bullet || k == MethodKind::Peer; }
+
 }  // namespace
 
-double LinkModel::seconds(const RunStats& s, std::size_t bytesPerBeat) const {
-  const double bytes = 24.0 * static_cast<double>(s.boxesSent) + static_cast<double>(bytesPerBeat * s.beatsReceived);
-  return static_cast<double>(s.runs) * latencySecondsPerRun + bytes / bandwidthBytesPerSecond;
-}
+ValidationFailure::ValidationFailure(std::string method, std::size_t objects, std::size_t frame, SetDifference d,
+                                     std::size_t exactPairs)
+    : std::runtime_error(fmt::format("n={} frame {}: {} gave {} missing and {} extra pairs against the exact set of {}",
+                                     objects, frame, method, d.missing, d.extra, exactPairs)),
+      method_(std::move(method)),
+      difference_(d) {}
 
 SetDifference compareSorted(const std::vector<Pair>& got, const std::vector<Pair>& exact) {
   SetDifference d;
@@ -74,23 +86,55 @@ SetDifference compareSorted(const std::vector<Pair>& got, const std::vector<Pair
   return d;
 }
 
-Benchmark::Benchmark(BenchConfig config, Progress progress) : config_(std::move(config)), progress_(std::move(progress)) {
+std::vector<MethodSpec> standardLineUp(const LineUpConfig& config) {
+  std::vector<MethodSpec> specs = bulletMethods(config.maxAllPairsTests);
+  for (auto&& group : {fclMethods(), cgalMethods(), odeMethods()})
+    for (auto& s : group) specs.push_back(s);
+  if (config.device)
+    for (auto& s : acceleratorMethods(config.device, config.cellSizes, config.maxAllPairsTests))
+      specs.push_back(std::move(s));
+  for (auto& s : cpuMethods(config.cellSizes, config.maxAllPairsTests)) specs.push_back(std::move(s));
+  return specs;
+}
+
+nlohmann::json describe(const LineUpConfig& config) {
+  nlohmann::json cells = nlohmann::json::array();
+  for (const auto& c : config.cellSizes) cells.push_back(cellName(c));
+  nlohmann::json j = {{"cell_sizes", cells}, {"max_all_pairs_tests_per_frame", config.maxAllPairsTests}};
+  if (const auto& d = config.device) {
+    j["accelerator_backend"] = d->backend;
+    j["hardware"] = d->hardware;
+    j["clock_hz"] = d->clockHz;
+    j["clock_source"] = d->clockSource;
+    j["link_model"] = {{"bandwidth_bytes_per_second", d->link.bandwidthBytesPerSecond},
+                       {"latency_seconds_per_run", d->link.latencySecondsPerRun},
+                       {"bytes_per_box", LinkModel::kBytesPerBox},
+                       {"bytes_per_result_beat", d->beatBytes},
+                       {"formula", "transfer = runs * latency + max(0, box bytes / bandwidth - load cycles / clock) "
+                                   "+ result bytes / bandwidth; device = (load + compute + drain cycles) / clock"}};
+  }
+  return j;
+}
+
+Benchmark::Benchmark(BenchConfig config, std::vector<MethodSpec> lineUp, nlohmann::json configuration,
+                     Progress progress)
+    : config_(std::move(config)),
+      lineUp_(std::move(lineUp)),
+      configuration_(std::move(configuration)),
+      progress_(std::move(progress)) {
   if (config_.frames == 0) throw std::invalid_argument("bench: at least one timed frame");
-  if (config_.accelBackend != "rtl" && config_.accelBackend != "model")
-    throw std::invalid_argument("bench: accelerator backend must be rtl or model");
-  if (!(config_.clockHz > 0)) throw std::invalid_argument("bench: clock must be positive");
+  for (const auto& s : lineUp_)
+    if (s.name.empty() || !s.make) throw std::invalid_argument("bench: every method needs a name and a factory");
 }
 
 nlohmann::json Benchmark::run() {
   nlohmann::json out;
-  nlohmann::json cells = nlohmann::json::array();
-  for (const auto& c : config_.cellSizes) cells.push_back(cellName(c));
-  out["configuration"] = {
+  out["configuration"] = configuration_;
+  out["configuration"].update({
       {"object_counts", config_.objectCounts},
-      {"cell_sizes", cells},
-      {"accelerator_backend", config_.accelBackend},
       {"frames", config_.frames},
       {"warmup_frames", config_.warmup},
+      {"method_order", "shuffled every frame (seeded by the scene seed and the frame)"},
       {"scene",
        {{"min_size", config_.scene.minSize},
         {"max_size", config_.scene.maxSize},
@@ -99,138 +143,106 @@ nlohmann::json Benchmark::run() {
         {"max_spin", config_.scene.maxSpin},
         {"time_step", config_.scene.timeStep},
         {"seed", config_.scene.seed}}},
-      {"hardware",
-       {{"m", BPACCEL_M},
-        {"capacity", BPACCEL_CAPACITY},
-        {"key_width", BPACCEL_KEY_WIDTH},
-        {"run_overhead_cycles", BPACCEL_RUN_OVERHEAD_CYCLES},
-        {"fingerprint", BPACCEL_FINGERPRINT}}},
-      {"clock_hz", config_.clockHz},
-      {"clock_source", config_.clockSource},
-      {"link_model",
-       {{"bandwidth_bytes_per_second", config_.link.bandwidthBytesPerSecond},
-        {"latency_seconds_per_run", config_.link.latencySecondsPerRun},
-        {"bytes_per_box", 24},
-        {"bytes_per_result_beat", beatBytes()}}},
-  };
+  });
   out["machine"] = {{"cpu", machineDescription()},
                     {"hardware_threads", std::thread::hardware_concurrency()},
                     {"compiler", __VERSION__},
-                    {"bullet", "3.24 (Debian libbullet-dev)"}};
+                    {"libraries",
+                     {"Bullet 3.24", "FCL 0.7.0", "CGAL 5.5.1", "ODE 0.16.2 (double precision)"}}};
   out["notes"] = {
-      {"measured", "Bullet broad phases, cpu backend, accelerator host part (float-to-key conversion, k-d tree, "
-                   "packing, remapping and filtering pairs)"},
-      {"modelled", "accelerator device part (hardware cycles / clock) and transfer part (link model)"}};
+      {"measured", "Bullet and peer broad phases, cpu backend, accelerator host part (float-to-key conversion, k-d "
+                   "tree, packing, remapping and filtering pairs)"},
+      {"modelled", "accelerator device part (device cycles, loads included, / clock) and transfer part (link model)"},
+      {"threads", "every method runs on one thread"}};
   out["rows"] = nlohmann::json::array();
   for (std::size_t n : config_.objectCounts) out["rows"].push_back(runRow(n));
-  out["validation"] = "every frame: accelerator and cpu pair sets equal the exact set";
+  out["validation"] = "every frame of every method compared with the exact set: accelerator and cpu equal to it (a "
+                      "difference stops the run); Bullet and peers counted (extra allowed, missing reported)";
   return out;
 }
 
 nlohmann::json Benchmark::runRow(std::size_t objects) {
   SceneConfig sc = config_.scene;
   sc.objects = objects;
+  const auto tScene = Clock::now();
   BouncingCubeScene scene(sc);
   std::vector<Aabb> boxes;
   scene.aabbs(boxes);
-
+  const double sceneSetup = since(tScene);
+  // Objects stay inside the walls; the margin covers a box poking through a wall for a step.
   const float margin = 2 * sc.maxSize + 2;
-  std::vector<std::unique_ptr<BulletBroadphase>> bullets;
-  for (auto kind : {BulletBroadphase::Kind::Dbvt, BulletBroadphase::Kind::AxisSweep32, BulletBroadphase::Kind::Simple})
-    if (kind != BulletBroadphase::Kind::Simple || config_.includeSimple)
-      bullets.push_back(std::make_unique<BulletBroadphase>(kind, boxes, -margin, scene.cubeEdge() + margin));
+  const SceneStart start{boxes, -margin, scene.cubeEdge() + margin};
 
-  std::unique_ptr<Backend> accel;
-  if (config_.accelBackend == "rtl")
-    accel = std::make_unique<RtlBackend>();
-  else
-    accel = std::make_unique<ModelBackend>(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
-  CpuBackend cpu;
-  std::vector<std::unique_ptr<BroadPhase>> accelPhases, cpuPhases;
-  std::vector<MethodSamples> samples;
-  const auto method = [](std::string name, std::string kind, std::optional<std::size_t> cell) {
-    MethodSamples m;
-    m.name = std::move(name);
-    m.kind = std::move(kind);
-    m.cellSize = cell;
-    return m;
-  };
-  for (const auto& b : bullets) samples.push_back(method(BulletBroadphase::name(b->kind()), "bullet", std::nullopt));
-  for (const auto& c : config_.cellSizes) {
-    accelPhases.push_back(std::make_unique<BroadPhase>(*accel, c));
-    samples.push_back(method("accelerator k-d " + cellName(c), "accelerator", c));
-  }
-  for (const auto& c : config_.cellSizes) {
-    cpuPhases.push_back(std::make_unique<BroadPhase>(cpu, c));
-    samples.push_back(method("cpu k-d " + cellName(c), "cpu", c));
+  std::vector<Entry> entries(lineUp_.size());
+  std::vector<std::size_t> active;
+  for (std::size_t k = 0; k < lineUp_.size(); ++k) {
+    Entry& e = entries[k];
+    e.spec = &lineUp_[k];
+    if (e.spec->skipReason) e.skipped = e.spec->skipReason(objects);
+    if (e.skipped) {
+      progress_(fmt::format("n={} {}: skipped: {}", objects, e.spec->name, *e.skipped));
+      continue;
+    }
+    progress_(fmt::format("n={} {}: set-up", objects, e.spec->name));
+    const auto t0 = Clock::now();
+    e.method = e.spec->make(start);
+    e.setupSeconds = since(t0);
+    active.push_back(k);
   }
 
   std::vector<Pair> exact, got;
   std::uint64_t exactTotal = 0;
+  double physicsSeconds = 0, exactSeconds = 0, validationSeconds = 0;
   const std::size_t totalFrames = config_.warmup + config_.frames;
   const double energyStart = scene.kineticEnergy();
+  std::mt19937 shuffler(sc.seed);
+  std::vector<std::size_t> order = active;
   for (std::size_t frame = 0; frame < totalFrames; ++frame) {
     const bool timed = frame >= config_.warmup;
     progress_(fmt::format("n={} frame {}/{}{}", objects, frame + 1, totalFrames, timed ? "" : " (warm-up)"));
+    auto t = Clock::now();
     scene.step();
     scene.aabbs(boxes);
+    physicsSeconds += since(t);
+    t = Clock::now();
     exactPairs(boxes, exact);
+    exactSeconds += since(t);
     if (timed) exactTotal += exact.size();
-    std::size_t s = 0;
-
-    for (auto& b : bullets) {
-      auto& m = samples[s++];
+    // A new order every frame: no method always follows the one that empties the caches.
+    std::shuffle(order.begin(), order.end(), shuffler);
+    for (std::size_t k : order) {
+      Entry& e = entries[k];
       const auto t0 = Clock::now();
-      b->update(boxes);
-      const double t = since(t0);
-      b->pairs(got);
-      std::sort(got.begin(), got.end());
-      const auto d = compareSorted(got, exact);
-      if (timed) {
-        m.frameSeconds.push_back(t);
-        m.missing += d.missing;
-        m.extra += d.extra;
-      }
-    }
-
-    for (auto& phase : accelPhases) {
-      auto& m = samples[s++];
-      const auto t0 = Clock::now();
-      phase->findPairs(boxes, got);
+      e.method->update(boxes);
       const double wall = since(t0);
-      const HostTimes& ht = phase->times();
-      const RunStats& st = phase->stats();
-      const double host = wall - ht.backendSeconds;  // the device's simulation is not host work
-      const double device = static_cast<double>(st.cycles) / config_.clockHz;
-      const double transfer = config_.link.seconds(st, beatBytes());
-      if (config_.tamper) config_.tamper(got);
+      e.updateSeconds += wall;
+      const FrameTime ft = e.method->frameTime(wall);
+      const auto tv = Clock::now();
+      e.method->pairs(got);
       std::sort(got.begin(), got.end());
-      const auto d = compareSorted(got, exact);
-      if (d.missing || d.extra)
-        throw ValidationFailure(fmt::format("n={} frame {}: {} gave {} missing and {} extra pairs against the exact "
-                                            "set of {}",
-                                            objects, frame, m.name, d.missing, d.extra, exact.size()));
-      if (timed) {
-        m.hostSeconds.push_back(host);
-        m.deviceSeconds.push_back(device);
-        m.transferSeconds.push_back(transfer);
-        m.frameSeconds.push_back(host + device + transfer);
-        m.cycles.push_back(static_cast<double>(st.cycles));
-        m.runs.push_back(static_cast<double>(st.runs));
+      // A pair reported twice (FCL's spatial hash, once per shared cell) is counted apart from extra pairs.
+      const auto unique = std::unique(got.begin(), got.end());
+      const auto duplicates = static_cast<std::uint64_t>(got.end() - unique);
+      got.erase(unique, got.end());
+      const SetDifference d = compareSorted(got, exact);
+      validationSeconds += since(tv);
+      e.missing += d.missing;
+      e.extra += d.extra;
+      e.duplicates += duplicates;
+      if (mustBeExact(e.spec->kind) && (d.missing || d.extra || duplicates))
+        throw ValidationFailure(e.spec->name, objects, frame, d, exact.size());
+      if (!timed) continue;
+      e.frameSeconds.push_back(ft.seconds);
+      if (const auto& p = ft.parts) {
+        e.hostSeconds.push_back(p->hostSeconds);
+        e.deviceSeconds.push_back(p->deviceSeconds);
+        e.transferSeconds.push_back(p->transferSeconds);
+        e.deviceCycles.push_back(static_cast<double>(p->stats.deviceCycles()));
+        e.loadCycles.push_back(static_cast<double>(p->stats.loadCycles));
+        e.cycles.push_back(static_cast<double>(p->stats.cycles));
+        e.runs.push_back(static_cast<double>(p->stats.runs));
+        e.boxesSent.push_back(static_cast<double>(p->stats.boxesSent));
       }
-    }
-
-    for (auto& phase : cpuPhases) {
-      auto& m = samples[s++];
-      const auto t0 = Clock::now();
-      phase->findPairs(boxes, got);
-      const double t = since(t0);
-      std::sort(got.begin(), got.end());
-      const auto d = compareSorted(got, exact);
-      if (d.missing || d.extra)
-        throw ValidationFailure(fmt::format("n={} frame {}: {} gave {} missing and {} extra pairs", objects, frame,
-                                            m.name, d.missing, d.extra));
-      if (timed) m.frameSeconds.push_back(t);
     }
   }
 
@@ -239,89 +251,211 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
   row["cube_edge"] = scene.cubeEdge();
   row["exact_pairs_per_frame_mean"] = static_cast<double>(exactTotal) / static_cast<double>(config_.frames);
   row["kinetic_energy_start_end"] = {energyStart, scene.kineticEnergy()};
-  double fastestBullet = INFINITY;
-  std::string fastestName;
-  for (const auto& m : samples)
-    if (m.kind == "bullet" && median(m.frameSeconds) < fastestBullet) {
-      fastestBullet = median(m.frameSeconds);
-      fastestName = m.name;
-    }
-  row["fastest_bullet"] = fastestName;
+
+  // The baselines a user would pick instead: the fastest of all that found
+  // every pair, and the fastest of each library.
+  const Entry* fastest = nullptr;
+  std::map<std::string, const Entry*> fastestOf;
+  for (const Entry& e : entries) {
+    if (!e.method || !isBaseline(e.spec->kind)) continue;
+    const double t = median(e.frameSeconds);
+    const Entry*& lib = fastestOf[e.spec->library];
+    if (!lib || t < median(lib->frameSeconds)) lib = &e;
+    if (e.missing == 0 && (!fastest || t < median(fastest->frameSeconds))) fastest = &e;
+  }
+  const auto baselineJson = [](const Entry* e) -> nlohmann::json {
+    if (!e) return nullptr;
+    return {{"name", e->spec->name}, {"library", e->spec->library}, {"frame_ms", median(e->frameSeconds) * 1e3}};
+  };
+  row["fastest_baseline"] = baselineJson(fastest);
+  row["fastest_per_library"] = nlohmann::json::object();
+  for (const auto& [lib, e] : fastestOf) row["fastest_per_library"][lib] = baselineJson(e);
+  if (fastestOf.count("Bullet 3.24")) row["fastest_bullet"] = fastestOf["Bullet 3.24"]->spec->name;
+
   nlohmann::json methods = nlohmann::json::array();
-  for (const auto& m : samples) {
+  for (const Entry& e : entries) {
     nlohmann::json j;
-    j["name"] = m.name;
-    j["kind"] = m.kind;
-    j["cell_size"] = m.cellSize ? nlohmann::json(*m.cellSize) : nlohmann::json("none");
-    j["frame_ms"] = summary(m.frameSeconds, 1e3);
-    if (m.kind == "accelerator") {
-      j["host_ms_measured"] = summary(m.hostSeconds, 1e3);
-      j["device_ms_modelled"] = summary(m.deviceSeconds, 1e3);
-      j["transfer_ms_modelled"] = summary(m.transferSeconds, 1e3);
-      j["cycles"] = summary(m.cycles, 1);
-      j["runs"] = summary(m.runs, 1);
+    j["name"] = e.spec->name;
+    j["kind"] = kindName(e.spec->kind);
+    j["library"] = e.spec->library;
+    j["cell_size"] = e.spec->cellSize ? nlohmann::json(*e.spec->cellSize) : nlohmann::json("none");
+    if (e.skipped) {
+      j["skipped"] = *e.skipped;
+      j["frame_ms"] = nullptr;
+      j["missing_pairs"] = nullptr;
+      j["extra_pairs"] = nullptr;
+      methods.push_back(j);
+      continue;
     }
-    if (m.kind == "bullet") {
-      j["missing_pairs"] = m.missing;  // must be 0: Bullet's sets contain the exact set
-      j["extra_pairs"] = m.extra;      // fattened or quantised boxes
-    } else {
-      j["missing_pairs"] = 0;
-      j["extra_pairs"] = 0;
+    j["frame_ms"] = summary(e.frameSeconds, 1e3);
+    j["missing_pairs"] = e.missing;
+    j["extra_pairs"] = e.extra;
+    j["duplicate_pairs"] = e.duplicates;
+    j["found_every_pair"] = e.missing == 0;
+    j["setup_s"] = e.setupSeconds;
+    j["update_s_total"] = e.updateSeconds;
+    if (!e.hostSeconds.empty()) {
+      j["host_ms_measured"] = summary(e.hostSeconds, 1e3);
+      j["device_ms_modelled"] = summary(e.deviceSeconds, 1e3);
+      j["transfer_ms_modelled"] = summary(e.transferSeconds, 1e3);
+      j["device_cycles"] = summary(e.deviceCycles, 1);
+      j["load_cycles"] = summary(e.loadCycles, 1);
+      j["cycles"] = summary(e.cycles, 1);
+      j["runs"] = summary(e.runs, 1);
+      j["boxes_sent"] = summary(e.boxesSent, 1);
     }
-    nlohmann::json acc;
-    for (const auto& b : samples)
-      if (b.kind == "bullet") acc[b.name] = median(b.frameSeconds) / median(m.frameSeconds);
+    const double mine = median(e.frameSeconds);
+    nlohmann::json acc = nlohmann::json::object();
+    for (const Entry& b : entries)
+      if (b.method && isBaseline(b.spec->kind)) acc[b.spec->name] = median(b.frameSeconds) / mine;
     j["acceleration_over"] = acc;
+    j["acceleration_over_fastest_baseline"] = fastest ? nlohmann::json(median(fastest->frameSeconds) / mine) : nullptr;
     methods.push_back(j);
   }
   row["methods"] = methods;
+
+  nlohmann::json setup = nlohmann::json::object(), update = nlohmann::json::object();
+  for (const Entry& e : entries)
+    if (e.method) {
+      setup[e.spec->name] = e.setupSeconds;
+      update[e.spec->name] = e.updateSeconds;
+    }
+  row["time_s"] = {{"scene_setup", sceneSetup},       {"physics_steps", physicsSeconds},
+                   {"exact_reference", exactSeconds}, {"validation", validationSeconds},
+                   {"method_setup", setup},           {"method_updates", update}};
   return row;
 }
+
+namespace {
+
+std::string pad(const std::string& s, std::size_t w) { return s.size() >= w ? s + " " : s + std::string(w - s.size(), ' '); }
+
+const nlohmann::json* findMethod(const nlohmann::json& row, const std::string& name) {
+  for (const auto& m : row["methods"])
+    if (m["name"] == name) return &m;
+  return nullptr;
+}
+
+}  // namespace
 
 std::string Benchmark::table(const nlohmann::json& results) {
   std::string t;
   const auto& rows = results["rows"];
   if (rows.empty()) return t;
-  // Methods as rows, object counts as columns, like the seed's table turned on its side.
-  std::vector<std::string> names;
-  for (const auto& m : rows[0]["methods"]) names.push_back(m["name"]);
+  const auto& cfg = results["configuration"];
+  constexpr std::size_t kName = 32, kCol = 16;
+  std::vector<std::string> names;  // every method of any row, in line-up order
+  for (const auto& r : rows)
+    for (const auto& m : r["methods"])
+      if (std::find(names.begin(), names.end(), m["name"].get<std::string>()) == names.end()) names.push_back(m["name"]);
   const auto header = [&](const std::string& title) {
-    t += fmt::format("\n{}\n{:<28}", title, "method");
+    t += fmt::format("\n{}\n{}", title, pad("method", kName));
     for (const auto& r : rows) t += fmt::format("{:>16}", fmt::format("n={}", r["objects"].get<std::size_t>()));
     t += "\n";
   };
-  header(fmt::format("Median broad-phase time per frame, ms (accelerator = measured host + modelled device at "
-                     "{:.1f} MHz + modelled transfer; {} backend)",
-                     results["configuration"]["clock_hz"].get<double>() / 1e6,
-                     results["configuration"]["accelerator_backend"].get<std::string>()));
-  for (const auto& name : names) {
-    t += fmt::format("{:<28}", name);
+  const auto kindOf = [&](const std::string& name) {
     for (const auto& r : rows)
-      for (const auto& m : r["methods"])
-        if (m["name"] == name) t += fmt::format("{:>16.4f}", m["frame_ms"]["median"].get<double>());
+      if (const auto* m = findMethod(r, name)) return (*m)["kind"].get<std::string>();
+    return std::string();
+  };
+  const auto isOurs = [&](const std::string& name) {
+    const auto k = kindOf(name);
+    return k == "accelerator" || k == "cpu";
+  };
+
+  std::string legend = "accelerator = measured host + modelled device + modelled transfer";
+  if (cfg.contains("clock_hz"))
+    legend = fmt::format(
+        "accelerator = measured host + modelled device ({:.1f} MHz, device cycles with loads, {} backend) + modelled "
+        "transfer ({:.1f} GB/s, {:.1f} us per run; boxes stream through the 24-byte-a-cycle load port, so only the "
+        "link's excess over the load cycles counts)",
+        cfg["clock_hz"].get<double>() / 1e6, cfg["accelerator_backend"].get<std::string>(),
+        cfg["link_model"]["bandwidth_bytes_per_second"].get<double>() / 1e9,
+        cfg["link_model"]["latency_seconds_per_run"].get<double>() * 1e6);
+  header("Median broad-phase time per frame, ms, one thread (" + legend +
+         "; ! = missed exact pairs; - = skipped, see below)");
+  for (const auto& name : names) {
+    t += pad(name, kName);
+    for (const auto& r : rows) {
+      const auto* m = findMethod(r, name);
+      if (!m || m->contains("skipped"))
+        t += fmt::format("{:>16}", "-");
+      else
+        t += fmt::format("{:>15.4f}{}", (*m)["frame_ms"]["median"].get<double>(),
+                         (*m)["missing_pairs"].get<std::uint64_t>() ? "!" : " ");
+    }
     t += "\n";
   }
-  for (const auto& bullet : rows[0]["methods"]) {
-    if (bullet["kind"] != "bullet") continue;
-    const std::string bname = bullet["name"];
-    header("Acceleration over " + bname + " (its median / the method's median)");
+
+  const auto accelerationBlock = [&](const std::string& title, const auto& baselineOf) {
+    header(title);
+    t += "  over:";
+    for (const auto& r : rows) {
+      const nlohmann::json b = baselineOf(r);
+      t += fmt::format(" n={} {};", r["objects"].get<std::size_t>(),
+                       b.is_null() ? std::string("-")
+                                   : fmt::format("{} ({:.4f} ms)", b["name"].get<std::string>(), b["frame_ms"].get<double>()));
+    }
+    t += "\n";
     for (const auto& name : names) {
-      if (name.rfind("bt", 0) == 0) continue;
-      t += fmt::format("{:<28}", name);
-      for (const auto& r : rows)
-        for (const auto& m : r["methods"])
-          if (m["name"] == name) t += fmt::format("{:>15.1f}x", m["acceleration_over"][bname].get<double>());
+      if (!isOurs(name)) continue;
+      t += pad(name, kName);
+      for (const auto& r : rows) {
+        const nlohmann::json b = baselineOf(r);
+        const auto* m = findMethod(r, name);
+        if (b.is_null() || !m || m->contains("skipped"))
+          t += fmt::format("{:>16}", "-");
+        else
+          t += fmt::format("{:>15.1f}x", b["frame_ms"].get<double>() / (*m)["frame_ms"]["median"].get<double>());
+      }
       t += "\n";
     }
-  }
+  };
+  accelerationBlock("Acceleration over the FASTEST of Bullet and the peers in the same run (of those that found "
+                    "every pair; named per column)",
+                    [](const nlohmann::json& r) { return r["fastest_baseline"]; });
+  std::vector<std::string> libraries;
+  for (const auto& r : rows)
+    for (const auto& [lib, b] : r["fastest_per_library"].items())
+      if (std::find(libraries.begin(), libraries.end(), lib) == libraries.end()) libraries.push_back(lib);
+  for (const auto& lib : libraries)
+    accelerationBlock("Acceleration over the fastest of " + lib + " (named per column)", [&](const nlohmann::json& r) {
+      return r["fastest_per_library"].contains(lib) ? r["fastest_per_library"][lib] : nlohmann::json();
+    });
+
   t += "\nExact pairs per frame (mean):";
-  for (const auto& r : rows) t += fmt::format(" n={}: {:.0f}", r["objects"].get<std::size_t>(), r["exact_pairs_per_frame_mean"].get<double>());
-  t += "\nBullet extra pairs over all timed frames (fattened/quantised boxes; missing must be 0):";
+  for (const auto& r : rows)
+    t += fmt::format(" n={}: {:.0f}", r["objects"].get<std::size_t>(), r["exact_pairs_per_frame_mean"].get<double>());
+  t += "\nExtra and missing pairs of Bullet and the peers over all frames (extra: padded or quantised boxes; a "
+       "missing pair is a finding):";
   for (const auto& r : rows)
     for (const auto& m : r["methods"])
-      if (m["kind"] == "bullet")
-        t += fmt::format("\n  n={} {}: extra {}, missing {}", r["objects"].get<std::size_t>(), m["name"].get<std::string>(),
-                         m["extra_pairs"].get<std::uint64_t>(), m["missing_pairs"].get<std::uint64_t>());
+      if ((m["kind"] == "bullet" || m["kind"] == "peer") && !m.contains("skipped"))
+        t += fmt::format("\n  n={} {}: extra {}, duplicates {}, missing {}{}", r["objects"].get<std::size_t>(),
+                         m["name"].get<std::string>(), m["extra_pairs"].get<std::uint64_t>(),
+                         m["duplicate_pairs"].get<std::uint64_t>(), m["missing_pairs"].get<std::uint64_t>(),
+                         m["missing_pairs"].get<std::uint64_t>() ? "  <-- INEXACT: not a fair competitor" : "");
+  bool anySkipped = false;
+  for (const auto& r : rows)
+    for (const auto& m : r["methods"])
+      if (m.contains("skipped")) {
+        if (!anySkipped) t += "\nSkipped:";
+        anySkipped = true;
+        t += fmt::format("\n  n={} {}: skipped: {}", r["objects"].get<std::size_t>(), m["name"].get<std::string>(),
+                         m["skipped"].get<std::string>());
+      }
+  t += "\nWhere the time went, s (scene set-up, physics steps, exact reference, validation; set-up and timed "
+       "updates summed over methods):";
+  for (const auto& r : rows) {
+    const auto& ts = r["time_s"];
+    double setup = 0, updates = 0;
+    for (const auto& [k, v] : ts["method_setup"].items()) setup += v.get<double>();
+    for (const auto& [k, v] : ts["method_updates"].items()) updates += v.get<double>();
+    t += fmt::format("\n  n={}: scene {:.2f}, physics {:.2f}, reference {:.2f}, validation {:.2f}, method set-up "
+                     "{:.2f}, method updates {:.2f}",
+                     r["objects"].get<std::size_t>(), ts["scene_setup"].get<double>(), ts["physics_steps"].get<double>(),
+                     ts["exact_reference"].get<double>(), ts["validation"].get<double>(), setup, updates);
+  }
   t += "\n";
   return t;
 }

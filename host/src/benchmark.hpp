@@ -1,68 +1,60 @@
 #pragma once
-// The bouncing-cube benchmark: Bullet's broad phases against the accelerator.
+// The bouncing-cube benchmark: every broad phase behind TimedMethod, timed
+// and validated by one loop, frame after frame, on the same scene.
 
 #include <functional>
+#include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "accelerator_method.hpp"
 #include "scene.hpp"
+#include "timed_method.hpp"
 #include "types.hpp"
 
 namespace bpaccel {
 
-/// Modelled link between host and accelerator: bytes over a bandwidth plus a latency per run.
-struct LinkModel {
-  double bandwidthBytesPerSecond = 4e9;  // a PCIe Gen3 x4 link's order of magnitude
-  double latencySecondsPerRun = 1e-6;    // one command and one completion per run
-  double seconds(const RunStats& s, std::size_t beatBytes) const;
-};
-
 struct BenchConfig {
   std::vector<std::size_t> objectCounts{100, 1000, 8000};
-  std::vector<std::optional<std::size_t>> cellSizes{std::nullopt, 16, 32, 64, 128, 256};
-  std::string accelBackend = "rtl";  // rtl or model: where the device's cycles come from
-  std::size_t frames = 50;           // timed frames per row
-  std::size_t warmup = 5;            // frames simulated and run but not timed
-  SceneConfig scene;                 // objects is set per row
-  double clockHz = 100e6;
-  std::string clockSource = "default 100 MHz";
-  LinkModel link;
-  std::string jsonPath = "results/bench.json";
-  bool includeSimple = true;         // btSimpleBroadphase is O(n^2): skip for huge scenes
-  /// Test hook: applied to every accelerator pair set before validation, so a
-  /// test can prove that a wrong answer fails the run.
-  std::function<void(std::vector<Pair>&)> tamper;
+  std::size_t frames = 50;  // timed frames per row
+  std::size_t warmup = 5;   // frames simulated and run but not timed
+  SceneConfig scene;        // objects is set per row
 };
 
-/// Per-frame samples of one method in one row.
-struct MethodSamples {
-  std::string name;
-  std::string kind;                       // bullet, accelerator, cpu
-  std::optional<std::size_t> cellSize;
-  std::vector<double> frameSeconds;       // what the table reports
-  std::vector<double> hostSeconds;        // accelerator: measured host part
-  std::vector<double> deviceSeconds;      // accelerator: modelled from cycles
-  std::vector<double> transferSeconds;    // accelerator: modelled link
-  std::vector<double> cycles, runs;
-  std::uint64_t missing = 0, extra = 0;   // against the exact set, summed over frames
+/// What the standard line-up holds.
+struct LineUpConfig {
+  std::vector<std::optional<std::size_t>> cellSizes{std::nullopt, 16, 32, 64, 128, 256};
+  /// Methods that test all n(n-1)/2 pairs a frame are skipped above this.
+  double maxAllPairsTests = 1e8;
+  std::shared_ptr<const DeviceConfig> device;  // the accelerator's; none: no accelerator methods
 };
+
+/// Bullet's three broad phases, the peers (FCL, CGAL, ODE), then the
+/// accelerator and the cpu backend per cell size.
+std::vector<MethodSpec> standardLineUp(const LineUpConfig& config);
+/// The line-up's settings for the JSON's configuration.
+nlohmann::json describe(const LineUpConfig& config);
 
 class Benchmark {
  public:
   using Progress = std::function<void(const std::string&)>;
-  Benchmark(BenchConfig config, Progress progress);
+  /// `configuration` describes the line-up (see describe) and goes into the JSON.
+  Benchmark(BenchConfig config, std::vector<MethodSpec> lineUp, nlohmann::json configuration, Progress progress);
 
   /// Runs every row; throws ValidationFailure when an exact method is wrong.
   nlohmann::json run();
-  /// The seed-style tables as text.
+  /// The tables as text.
   static std::string table(const nlohmann::json& results);
 
  private:
   nlohmann::json runRow(std::size_t objects);
   BenchConfig config_;
+  std::vector<MethodSpec> lineUp_;
+  nlohmann::json configuration_;
   Progress progress_;
 };
 
@@ -72,9 +64,17 @@ struct SetDifference {
 };
 SetDifference compareSorted(const std::vector<Pair>& got, const std::vector<Pair>& exact);
 
+/// An exact method's pair set differed from the exact set.
 class ValidationFailure : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  ValidationFailure(std::string method, std::size_t objects, std::size_t frame, SetDifference difference,
+                    std::size_t exactPairs);
+  const std::string& method() const { return method_; }
+  const SetDifference& difference() const { return difference_; }
+
+ private:
+  std::string method_;
+  SetDifference difference_;
 };
 
 }  // namespace bpaccel

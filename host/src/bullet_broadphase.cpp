@@ -1,12 +1,27 @@
 #include "bullet_broadphase.hpp"
 
+#include <algorithm>
 #include <cstdint>
+#include <numeric>
 #include <stdexcept>
 
 #include <btBulletCollisionCommon.h>
 #include <BulletCollision/BroadphaseCollision/btAxisSweep3.h>
+#include <fmt/format.h>
 
 namespace bpaccel {
+namespace {
+
+constexpr const char* kBullet = "Bullet 3.24";
+// bt32BitAxisSweep3's handles are 32-bit; Bullet asserts fewer than 2^31 - 1.
+constexpr std::size_t kAxisSweepHandleLimit = 2147483646;
+// Beyond this, its O(n^2) set-up alone takes hours (about 40 s at 100,000 objects here).
+constexpr std::size_t kAxisSweepSetupLimit = 300000;
+
+btVector3 lo(const Aabb& b) { return {b.min[0], b.min[1], b.min[2]}; }
+btVector3 hi(const Aabb& b) { return {b.max[0], b.max[1], b.max[2]}; }
+
+}  // namespace
 
 std::string BulletBroadphase::name(Kind kind) {
   switch (kind) {
@@ -21,7 +36,7 @@ BulletBroadphase::BulletBroadphase(Kind kind, std::span<const Aabb> initial, flo
     : kind_(kind),
       config_(std::make_unique<btDefaultCollisionConfiguration>()),
       dispatcher_(std::make_unique<btCollisionDispatcher>(config_.get())) {
-  const int count = static_cast<int>(initial.size());
+  const std::size_t count = initial.size();
   switch (kind) {
     case Kind::Dbvt: broadphase_ = std::make_unique<btDbvtBroadphase>(); break;
     case Kind::AxisSweep32:
@@ -30,18 +45,23 @@ BulletBroadphase::BulletBroadphase(Kind kind, std::span<const Aabb> initial, flo
                                                          btVector3(worldMax, worldMax, worldMax),
                                                          static_cast<unsigned>(count + 2), nullptr, true);
       break;
-    case Kind::Simple: broadphase_ = std::make_unique<btSimpleBroadphase>(count + 2); break;
+    case Kind::Simple: broadphase_ = std::make_unique<btSimpleBroadphase>(static_cast<int>(count + 2)); break;
   }
-  proxies_.reserve(initial.size());
-  for (int i = 0; i < count; ++i) {
-    const Aabb& b = initial[static_cast<std::size_t>(i)];
-    proxies_.push_back(broadphase_->createProxy(btVector3(b.min[0], b.min[1], b.min[2]),
-                                                btVector3(b.max[0], b.max[1], b.max[2]), BOX_SHAPE_PROXYTYPE,
-                                                // index + 1: btSimpleBroadphase skips proxies whose client object is null
-                                                reinterpret_cast<void*>(static_cast<std::uintptr_t>(i) + 1),
-                                                btBroadphaseProxy::DefaultFilter, btBroadphaseProxy::AllFilter,
-                                                dispatcher_.get()));
-  }
+  // The sweep inserts each new proxy from the end of every axis's sorted edge
+  // list: created in order of min x, the x axis costs almost nothing (y and z
+  // cannot be ordered at the same time). The other broad phases do not care.
+  std::vector<std::uint32_t> order(count);
+  std::iota(order.begin(), order.end(), 0u);
+  if (kind == Kind::AxisSweep32)
+    std::sort(order.begin(), order.end(),
+              [&](std::uint32_t a, std::uint32_t b) { return initial[a].min[0] < initial[b].min[0]; });
+  proxies_.resize(count);
+  for (std::uint32_t i : order)
+    proxies_[i] = broadphase_->createProxy(lo(initial[i]), hi(initial[i]), BOX_SHAPE_PROXYTYPE,
+                                           // index + 1: btSimpleBroadphase skips proxies whose client object is null
+                                           reinterpret_cast<void*>(static_cast<std::uintptr_t>(i) + 1),
+                                           btBroadphaseProxy::DefaultFilter, btBroadphaseProxy::AllFilter,
+                                           dispatcher_.get());
   broadphase_->calculateOverlappingPairs(dispatcher_.get());
 }
 
@@ -51,15 +71,12 @@ BulletBroadphase::~BulletBroadphase() {
 
 void BulletBroadphase::update(std::span<const Aabb> boxes) {
   if (boxes.size() != proxies_.size()) throw std::invalid_argument("bullet broadphase: object count changed");
-  for (std::size_t i = 0; i < boxes.size(); ++i) {
-    const Aabb& b = boxes[i];
-    broadphase_->setAabb(proxies_[i], btVector3(b.min[0], b.min[1], b.min[2]), btVector3(b.max[0], b.max[1], b.max[2]),
-                         dispatcher_.get());
-  }
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    broadphase_->setAabb(proxies_[i], lo(boxes[i]), hi(boxes[i]), dispatcher_.get());
   broadphase_->calculateOverlappingPairs(dispatcher_.get());
 }
 
-void BulletBroadphase::pairs(std::vector<Pair>& out) const {
+void BulletBroadphase::pairs(std::vector<Pair>& out) {
   out.clear();
   const btBroadphasePairArray& array = broadphase_->getOverlappingPairCache()->getOverlappingPairArray();
   out.reserve(static_cast<std::size_t>(array.size()));
@@ -68,6 +85,32 @@ void BulletBroadphase::pairs(std::vector<Pair>& out) const {
     const auto b = static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(array[k].m_pProxy1->m_clientObject) - 1);
     out.emplace_back(std::min(a, b), std::max(a, b));
   }
+}
+
+std::optional<std::string> axisSweepSkipReason(std::size_t objects) {
+  if (objects > kAxisSweepHandleLimit)
+    return fmt::format("beyond its 32-bit handle limit ({} proxies)", kAxisSweepHandleLimit);
+  if (objects > kAxisSweepSetupLimit)
+    return fmt::format("set-up inserts each proxy by insertion sort on y and z: O(n^2), hours beyond {} objects",
+                       kAxisSweepSetupLimit);
+  return std::nullopt;
+}
+
+std::vector<MethodSpec> bulletMethods(double maxAllPairsTests) {
+  std::vector<MethodSpec> specs;
+  for (auto kind : {BulletBroadphase::Kind::Dbvt, BulletBroadphase::Kind::AxisSweep32, BulletBroadphase::Kind::Simple}) {
+    MethodSpec s;
+    s.name = BulletBroadphase::name(kind);
+    s.kind = MethodKind::Bullet;
+    s.library = kBullet;
+    if (kind == BulletBroadphase::Kind::AxisSweep32) s.skipReason = axisSweepSkipReason;
+    if (kind == BulletBroadphase::Kind::Simple) s.skipReason = allPairsSkipReason(maxAllPairsTests);
+    s.make = [kind](const SceneStart& start) {
+      return std::make_unique<BulletBroadphase>(kind, start.boxes, start.worldMin, start.worldMax);
+    };
+    specs.push_back(std::move(s));
+  }
+  return specs;
 }
 
 }  // namespace bpaccel

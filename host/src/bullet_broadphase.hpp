@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "timed_method.hpp"
 #include "types.hpp"
 
 class btBroadphaseInterface;
@@ -15,21 +16,21 @@ class btDefaultCollisionConfiguration;
 
 namespace bpaccel {
 
-class BulletBroadphase {
+class BulletBroadphase final : public TimedMethod {
  public:
   enum class Kind { Dbvt, AxisSweep32, Simple };
   static std::string name(Kind kind);
 
   /// Creates one proxy per box. `worldMin`/`worldMax` bound the sweep-and-prune's quantisation.
   BulletBroadphase(Kind kind, std::span<const Aabb> initial, float worldMin, float worldMax);
-  ~BulletBroadphase();
+  ~BulletBroadphase() override;
   BulletBroadphase(const BulletBroadphase&) = delete;
   BulletBroadphase& operator=(const BulletBroadphase&) = delete;
 
   /// setAabb for every object and calculateOverlappingPairs: the work timed per frame.
-  void update(std::span<const Aabb> boxes);
+  void update(std::span<const Aabb> boxes) override;
   /// The pairs in the broad phase's pair cache (i < j, unsorted).
-  void pairs(std::vector<Pair>& out) const;
+  void pairs(std::vector<Pair>& out) override;
   Kind kind() const { return kind_; }
 
  private:
@@ -37,7 +38,15 @@ class BulletBroadphase {
   std::unique_ptr<btDefaultCollisionConfiguration> config_;
   std::unique_ptr<btCollisionDispatcher> dispatcher_;
   std::unique_ptr<btBroadphaseInterface> broadphase_;
-  std::vector<btBroadphaseProxy*> proxies_;
+  std::vector<btBroadphaseProxy*> proxies_;  // index = object
 };
+
+/// Bullet's three broad phases for the benchmark. btSimpleBroadphase tests
+/// all pairs every frame: it is skipped above `maxAllPairsTests` pair tests a frame.
+std::vector<MethodSpec> bulletMethods(double maxAllPairsTests);
+
+/// Why bt32BitAxisSweep3 cannot run at `objects`, if it cannot: Bullet inserts
+/// each proxy by insertion sort on every axis, so its set-up is O(n^2).
+std::optional<std::string> axisSweepSkipReason(std::size_t objects);
 
 }  // namespace bpaccel

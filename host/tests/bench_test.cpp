@@ -1,9 +1,15 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
+#include <set>
 
+#include "backend.hpp"
 #include "benchmark.hpp"
+#include "bpaccel_params.h"
+#include "bullet_broadphase.hpp"
 #include "exact_pairs.hpp"
+#include "rtl_backend.hpp"
 #include "scene.hpp"
 #include "scenes.hpp"
 
@@ -14,21 +20,110 @@ namespace {
 BenchConfig tinyConfig() {
   BenchConfig c;
   c.objectCounts = {30, 60};
-  c.cellSizes = {std::nullopt, 4, 16};
   c.frames = 3;
   c.warmup = 1;
-  c.accelBackend = "rtl";
   return c;
+}
+
+std::shared_ptr<DeviceConfig> rtlDevice() {
+  auto d = std::make_shared<DeviceConfig>();
+  d->backend = "rtl";
+  d->makeBackend = [] { return std::make_unique<RtlBackend>(); };
+  d->beatBytes = 4;
+  d->hardware = {{"m", BPACCEL_M}, {"capacity", BPACCEL_CAPACITY}};
+  return d;
+}
+
+LineUpConfig tinyLineUp() {
+  LineUpConfig l;
+  l.cellSizes = {std::nullopt, 4, 16};
+  l.device = rtlDevice();
+  return l;
+}
+
+nlohmann::json runQuietly(const BenchConfig& config, std::vector<MethodSpec> lineUp, const LineUpConfig& l) {
+  Benchmark bench(config, std::move(lineUp), describe(l), [](const std::string&) {});
+  return bench.run();
+}
+
+// Decorates a method: its pairs pass through `edit` before validation.
+class Tampered final : public TimedMethod {
+ public:
+  Tampered(std::unique_ptr<TimedMethod> inner, std::function<void(std::vector<Pair>&)> edit)
+      : inner_(std::move(inner)), edit_(std::move(edit)) {}
+  void update(std::span<const Aabb> boxes) override { inner_->update(boxes); }
+  void pairs(std::vector<Pair>& out) override {
+    inner_->pairs(out);
+    edit_(out);
+  }
+  FrameTime frameTime(double s) const override { return inner_->frameTime(s); }
+
+ private:
+  std::unique_ptr<TimedMethod> inner_;
+  std::function<void(std::vector<Pair>&)> edit_;
+};
+
+std::vector<MethodSpec> tamperedAccelerator(std::function<void(std::vector<Pair>&)> edit) {
+  auto specs = acceleratorMethods(rtlDevice(), {16}, 1e8);
+  auto make = specs[0].make;
+  specs[0].make = [make, edit](const SceneStart& s) { return std::make_unique<Tampered>(make(s), edit); };
+  return specs;
+}
+
+// A peer with a fixed frame time, exact or missing one pair a frame, that logs when it runs.
+class FakePeer final : public TimedMethod {
+ public:
+  FakePeer(int id, double seconds, bool dropOne, std::vector<int>* log)
+      : id_(id), seconds_(seconds), dropOne_(dropOne), log_(log) {}
+  void update(std::span<const Aabb> boxes) override {
+    sortAndSweepPairs(boxes, pairs_);
+    if (dropOne_ && !pairs_.empty()) pairs_.pop_back();
+    if (log_) log_->push_back(id_);
+  }
+  void pairs(std::vector<Pair>& out) override { out = pairs_; }
+  FrameTime frameTime(double) const override { return {seconds_, std::nullopt}; }
+
+ private:
+  int id_;
+  double seconds_;
+  bool dropOne_;
+  std::vector<int>* log_;
+  std::vector<Pair> pairs_;
+};
+
+MethodSpec fakePeer(int id, double seconds, bool dropOne, std::vector<int>* log = nullptr) {
+  MethodSpec s;
+  s.name = "fake " + std::to_string(id);
+  s.kind = MethodKind::Peer;
+  s.library = "Fake";
+  s.make = [=](const SceneStart&) { return std::make_unique<FakePeer>(id, seconds, dropOne, log); };
+  return s;
 }
 
 }  // namespace
 
 TEST(ExactPairs, MatchesBruteForceOnAdversarialScenes) {
   for (const auto& [name, boxes] : bpaccel::testing::adversarialScenes(300, 4)) {
-    std::vector<Pair> pairs;
-    exactPairs(boxes, pairs);
-    EXPECT_EQ(pairs, bpaccel::testing::bruteForce(boxes)) << name;
+    std::vector<Pair> grid, sweep;
+    exactPairs(boxes, grid);
+    sortAndSweepPairs(boxes, sweep);
+    const auto brute = bpaccel::testing::bruteForce(boxes);
+    EXPECT_EQ(grid, brute) << name;
+    EXPECT_EQ(sweep, brute) << name;
   }
+}
+
+TEST(ExactPairs, GridFindsPairsAcrossCellBoundariesOfABouncingScene) {
+  SceneConfig sc;
+  sc.objects = 3000;
+  BouncingCubeScene scene(sc);
+  for (int f = 0; f < 3; ++f) scene.step();
+  std::vector<Aabb> boxes;
+  scene.aabbs(boxes);
+  std::vector<Pair> grid;
+  exactPairs(boxes, grid);
+  EXPECT_GT(grid.size(), 100u);
+  EXPECT_EQ(grid, bpaccel::testing::bruteForce(boxes));
 }
 
 TEST(Scene, KeepsObjectsMovingInsideTheCube) {
@@ -56,44 +151,141 @@ TEST(Scene, RejectsImpossibleParameters) {
   EXPECT_THROW(BouncingCubeScene{sc}, std::invalid_argument);
 }
 
-TEST(Benchmark, ProducesEveryFieldAndATableOnATinyScene) {
-  Benchmark bench(tinyConfig(), [](const std::string&) {});
-  const auto j = bench.run();
+TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
+  const auto l = tinyLineUp();
+  const auto j = runQuietly(tinyConfig(), standardLineUp(l), l);
   for (const char* key : {"configuration", "machine", "rows", "validation", "notes"}) EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["configuration"]["clock_hz"], 100e6);
   ASSERT_EQ(j["rows"].size(), 2u);
+  std::set<std::string> kinds, libraries;
   for (const auto& row : j["rows"]) {
     EXPECT_TRUE(row.contains("exact_pairs_per_frame_mean"));
-    ASSERT_EQ(row["methods"].size(), 3u + 3u + 3u);  // three Bullet broad phases, accelerator and cpu per cell size
+    EXPECT_FALSE(row["fastest_baseline"].is_null());
+    // Bullet 3, FCL 3, CGAL 1, ODE 2, then accelerator and cpu per cell size.
+    ASSERT_EQ(row["methods"].size(), 3u + 3u + 1u + 2u + 3u + 3u);
     for (const auto& m : row["methods"]) {
+      kinds.insert(m["kind"]);
+      libraries.insert(m["library"]);
+      ASSERT_FALSE(m.contains("skipped")) << m["name"];
       EXPECT_GT(m["frame_ms"]["median"].get<double>(), 0) << m["name"];
-      EXPECT_EQ(m["missing_pairs"], 0) << m["name"];
-      EXPECT_EQ(m["acceleration_over"].size(), 3u);
+      EXPECT_TRUE(m["missing_pairs"].is_number() && m["extra_pairs"].is_number()) << m["name"];
+      if (m["kind"] == "accelerator" || m["kind"] == "cpu") EXPECT_EQ(m["missing_pairs"], 0) << m["name"];
+      EXPECT_EQ(m["acceleration_over"].size(), 9u);
       if (m["kind"] == "accelerator")
-        for (const char* part : {"host_ms_measured", "device_ms_modelled", "transfer_ms_modelled", "cycles", "runs"})
+        for (const char* part : {"host_ms_measured", "device_ms_modelled", "transfer_ms_modelled", "device_cycles",
+                                 "load_cycles", "runs"})
           EXPECT_TRUE(m.contains(part)) << part;
     }
   }
+  EXPECT_EQ(kinds, (std::set<std::string>{"bullet", "peer", "accelerator", "cpu"}));
+  EXPECT_EQ(libraries, (std::set<std::string>{"Bullet 3.24", "FCL 0.7", "CGAL 5.5", "ODE 0.16", "bpaccel"}));
   const std::string table = Benchmark::table(j);
-  EXPECT_NE(table.find("btDbvtBroadphase"), std::string::npos);
-  EXPECT_NE(table.find("accelerator k-d 16"), std::string::npos);
-  EXPECT_NE(table.find("Acceleration over bt32BitAxisSweep3"), std::string::npos);
+  for (const char* s : {"btDbvtBroadphase", "FCL DynamicAABBTree", "CGAL box_self_intersection_d", "ODE dHashSpace",
+                        "accelerator k-d 16", "Acceleration over the FASTEST", "Acceleration over the fastest of FCL 0.7"})
+    EXPECT_NE(table.find(s), std::string::npos) << s;
 }
 
-TEST(Benchmark, FailsLoudlyWhenTheAcceleratorMissesAPair) {
-  auto config = tinyConfig();
-  config.tamper = [](std::vector<Pair>& pairs) {
-    if (!pairs.empty()) pairs.pop_back();
-  };
-  Benchmark bench(config, [](const std::string&) {});
-  EXPECT_THROW(bench.run(), ValidationFailure);
+TEST(Benchmark, AnExactMethodThatMissesAPairFailsTheRunWithTheCount) {
+  const auto l = tinyLineUp();
+  try {
+    runQuietly(tinyConfig(), tamperedAccelerator([](std::vector<Pair>& p) {
+                 if (!p.empty()) p.pop_back();
+               }),
+               l);
+    FAIL() << "no ValidationFailure";
+  } catch (const ValidationFailure& e) {
+    EXPECT_EQ(e.method(), "accelerator k-d 16");
+    EXPECT_EQ(e.difference().missing, 1u);
+    EXPECT_EQ(e.difference().extra, 0u);
+  }
 }
 
-TEST(Benchmark, FailsLoudlyWhenTheAcceleratorInventsAPair) {
+TEST(Benchmark, AnExactMethodThatInventsAPairFailsTheRunWithTheCount) {
+  const auto l = tinyLineUp();
+  try {
+    runQuietly(tinyConfig(), tamperedAccelerator([](std::vector<Pair>& p) { p.emplace_back(0, 1000000); }), l);
+    FAIL() << "no ValidationFailure";
+  } catch (const ValidationFailure& e) {
+    EXPECT_EQ(e.difference().missing, 0u);
+    EXPECT_EQ(e.difference().extra, 1u);
+  }
+}
+
+TEST(Benchmark, APeerThatMissesPairsIsCountedAndMarkedNotFailed) {
+  LineUpConfig l;
   auto config = tinyConfig();
-  config.tamper = [](std::vector<Pair>& pairs) { pairs.emplace_back(0, 1000000); };
-  Benchmark bench(config, [](const std::string&) {});
-  EXPECT_THROW(bench.run(), ValidationFailure);
+  const auto j = runQuietly(config, {fakePeer(0, 1e-3, false), fakePeer(1, 1e-3, true)}, l);
+  for (const auto& row : j["rows"]) {
+    const auto& exact = row["methods"][0];
+    const auto& inexact = row["methods"][1];
+    EXPECT_EQ(exact["missing_pairs"], 0);
+    EXPECT_EQ(inexact["missing_pairs"], config.frames + config.warmup);  // one a frame, warm-up included
+    EXPECT_FALSE(inexact["found_every_pair"].get<bool>());
+  }
+  const std::string table = Benchmark::table(j);
+  EXPECT_NE(table.find("fake 1: extra 0, duplicates 0, missing 4  <-- INEXACT"), std::string::npos) << table;
+  EXPECT_NE(table.find("!"), std::string::npos);
+}
+
+TEST(Benchmark, TheHeadlineIsOverTheFastestBaselineThatFoundEveryPair) {
+  LineUpConfig l;
+  auto lineUp = std::vector<MethodSpec>{fakePeer(0, 3e-3, false), fakePeer(1, 1e-3, true), fakePeer(2, 2e-3, false)};
+  lineUp.push_back(cpuMethods({4}, 1e8)[0]);
+  const auto j = runQuietly(tinyConfig(), lineUp, l);
+  for (const auto& row : j["rows"]) {
+    EXPECT_EQ(row["fastest_baseline"]["name"], "fake 2");  // fake 1 is faster but missed pairs
+    EXPECT_DOUBLE_EQ(row["fastest_baseline"]["frame_ms"].get<double>(), 2.0);
+    EXPECT_EQ(row["fastest_per_library"]["Fake"]["name"], "fake 1");
+    const auto& slow = row["methods"][0];
+    EXPECT_DOUBLE_EQ(slow["acceleration_over_fastest_baseline"].get<double>(), 2.0 / 3.0);
+  }
+}
+
+TEST(Benchmark, SkippedMethodsAreListedWithTheirReason) {
+  auto l = tinyLineUp();
+  l.maxAllPairsTests = 500;  // n = 30: 435 tests run; n = 60: 1770 tests skip
+  const auto j = runQuietly(tinyConfig(), standardLineUp(l), l);
+  std::set<std::string> skipped;
+  for (const auto& m : j["rows"][1]["methods"])
+    if (m.contains("skipped")) {
+      skipped.insert(m["name"]);
+      EXPECT_NE(m["skipped"].get<std::string>().find("tests all pairs"), std::string::npos);
+      EXPECT_TRUE(m["frame_ms"].is_null());
+    }
+  EXPECT_EQ(skipped, (std::set<std::string>{"btSimpleBroadphase", "accelerator k-d none", "cpu k-d none"}));
+  for (const auto& m : j["rows"][0]["methods"]) EXPECT_FALSE(m.contains("skipped")) << m["name"];
+  const std::string table = Benchmark::table(j);
+  EXPECT_NE(table.find("n=60 btSimpleBroadphase: skipped: tests all pairs"), std::string::npos) << table;
+}
+
+TEST(Benchmark, TheAxisSweepIsSkippedWhereItsSetUpCannotFinish) {
+  EXPECT_FALSE(axisSweepSkipReason(100000).has_value());
+  const auto reason = axisSweepSkipReason(1000000);
+  ASSERT_TRUE(reason.has_value());
+  EXPECT_NE(reason->find("O(n^2)"), std::string::npos);
+}
+
+TEST(Benchmark, MethodsRunInADifferentOrderEveryFrame) {
+  LineUpConfig l;
+  std::vector<int> log;
+  constexpr int kMethods = 4;
+  std::vector<MethodSpec> lineUp;
+  for (int i = 0; i < kMethods; ++i) lineUp.push_back(fakePeer(i, 1e-3, false, &log));
+  auto config = tinyConfig();
+  config.objectCounts = {20};
+  config.frames = 20;
+  runQuietly(config, lineUp, l);
+  ASSERT_EQ(log.size(), kMethods * (config.frames + config.warmup));
+  std::set<int> firsts, predecessorsOfZero;
+  for (std::size_t f = 0; f < log.size() / kMethods; ++f) {
+    const std::vector<int> frame(log.begin() + static_cast<long>(f * kMethods), log.begin() + static_cast<long>((f + 1) * kMethods));
+    EXPECT_EQ(std::set<int>(frame.begin(), frame.end()).size(), std::size_t{kMethods});  // each once a frame
+    firsts.insert(frame[0]);
+    const auto zero = std::find(frame.begin(), frame.end(), 0);
+    if (zero != frame.begin()) predecessorsOfZero.insert(*(zero - 1));
+  }
+  EXPECT_GE(firsts.size(), 3u);
+  EXPECT_GE(predecessorsOfZero.size(), 2u);  // not always after the same method
 }
 
 TEST(CompareSorted, CountsMissingAndExtraPairs) {
@@ -104,11 +296,36 @@ TEST(CompareSorted, CountsMissingAndExtraPairs) {
   EXPECT_EQ(d.extra, 2u);
 }
 
-TEST(LinkModel, ChargesBytesAndLatencyPerRun) {
-  LinkModel link{1e9, 2e-6};
+TEST(LinkModel, ALinkSlowerThanTheLoadPortAddsOnlyItsExcess) {
+  LinkModel link{1e9, 2e-6};  // 1 GB/s: 24 kB of boxes take 24 us
   RunStats s;
   s.runs = 3;
   s.boxesSent = 1000;
+  s.loadCycles = 1000;  // 10 us at 100 MHz through the load port
   s.beatsReceived = 500;
-  EXPECT_DOUBLE_EQ(link.seconds(s, 4), 3 * 2e-6 + (24000.0 + 2000.0) / 1e9);
+  EXPECT_DOUBLE_EQ(link.seconds(s, 4, 100e6), 3 * 2e-6 + (24e-6 - 10e-6) + 2000.0 / 1e9);
+}
+
+TEST(LinkModel, ALinkFasterThanTheLoadPortAddsNothingForBoxes) {
+  LinkModel link{100e9, 1e-6};  // 24 kB in 0.24 us, the port needs 10 us: the loads (device time) dominate
+  RunStats s;
+  s.runs = 1;
+  s.boxesSent = 1000;
+  s.loadCycles = 1000;
+  s.beatsReceived = 0;
+  EXPECT_DOUBLE_EQ(link.seconds(s, 4, 100e6), 1e-6);
+}
+
+TEST(AcceleratorMethod, DeviceTimeCountsLoadCycles) {
+  auto d = std::make_shared<DeviceConfig>();
+  d->makeBackend = [] { return std::make_unique<ModelBackend>(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES); };
+  d->clockHz = 100e6;
+  AcceleratorMethod method(d, 16);
+  const auto boxes = bpaccel::testing::adversarialScenes(200, 1)[0].second;
+  method.update(boxes);
+  const FrameTime t = method.frameTime(0.0);
+  ASSERT_TRUE(t.parts.has_value());
+  EXPECT_DOUBLE_EQ(t.parts->deviceSeconds,
+                   static_cast<double>(t.parts->stats.loadCycles + t.parts->stats.cycles) / 100e6);
+  EXPECT_GT(t.parts->stats.cycles, 0u);
 }

@@ -1,0 +1,84 @@
+#pragma once
+// The project's own broad phase as benchmark methods: the accelerator (device
+// modelled from its cycle counters, host measured) and the cpu backend.
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "backend.hpp"
+#include "broad_phase.hpp"
+#include "timed_method.hpp"
+
+namespace bpaccel {
+
+/// Modelled link between host and accelerator. Boxes stream through the
+/// device's load port, one 24-byte box a cycle, while they arrive: the load
+/// cycles are device time, and the link adds only what it is slower than the
+/// port. Each run pays a latency (command and completion); result beats come
+/// back over the link.
+///   transfer = runs * latency + max(0, box bytes / bandwidth - load cycles / clock)
+///            + result bytes / bandwidth
+struct LinkModel {
+  static constexpr double kBytesPerBox = 24;
+  double bandwidthBytesPerSecond = 4e9;  // a PCIe Gen3 x4 link's order of magnitude
+  double latencySecondsPerRun = 1e-6;    // one command and one completion per run
+  double seconds(const RunStats& s, std::size_t bytesPerBeat, double clockHz) const;
+};
+
+/// The device the accelerator methods model, given at run time by the program
+/// that links a hardware configuration (the benchmark library links none).
+struct DeviceConfig {
+  std::string backend = "model";                      // where device cycles come from: rtl or model
+  std::function<std::unique_ptr<Backend>()> makeBackend;
+  std::size_t beatBytes = 0;                          // bytes of one result beat
+  nlohmann::json hardware;                            // m, capacity, ... as the JSON reports them
+  double clockHz = 100e6;
+  std::string clockSource = "default 100 MHz";
+  LinkModel link;
+};
+
+/// BroadPhase on the device: host part measured, device and link modelled.
+class AcceleratorMethod final : public TimedMethod {
+ public:
+  AcceleratorMethod(std::shared_ptr<const DeviceConfig> device, std::optional<std::size_t> cellSize);
+  void update(std::span<const Aabb> boxes) override { phase_.findPairs(boxes, pairs_); }
+  void pairs(std::vector<Pair>& out) override { out = pairs_; }
+  /// Host = measured wall time minus the time spent simulating the device;
+  /// device = every busy cycle (loads included) / clock; transfer = LinkModel.
+  FrameTime frameTime(double measuredSeconds) const override;
+
+ private:
+  std::shared_ptr<const DeviceConfig> device_;
+  std::unique_ptr<Backend> backend_;
+  BroadPhase phase_;
+  std::vector<Pair> pairs_;
+};
+
+/// BroadPhase on the cpu backend: software alone, all measured.
+class CpuMethod final : public TimedMethod {
+ public:
+  explicit CpuMethod(std::optional<std::size_t> cellSize) : phase_(backend_, cellSize) {}
+  void update(std::span<const Aabb> boxes) override { phase_.findPairs(boxes, pairs_); }
+  void pairs(std::vector<Pair>& out) override { out = pairs_; }
+
+ private:
+  CpuBackend backend_;
+  BroadPhase phase_;
+  std::vector<Pair> pairs_;
+};
+
+/// "accelerator k-d C" per cell size (none = no tree, all pairs: skipped above `maxAllPairsTests`).
+std::vector<MethodSpec> acceleratorMethods(std::shared_ptr<const DeviceConfig> device,
+                                           const std::vector<std::optional<std::size_t>>& cellSizes,
+                                           double maxAllPairsTests);
+/// "cpu k-d C" per cell size, with the same skip rule.
+std::vector<MethodSpec> cpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, double maxAllPairsTests);
+
+std::string cellName(const std::optional<std::size_t>& cellSize);
+
+}  // namespace bpaccel

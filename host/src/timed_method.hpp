@@ -1,0 +1,78 @@
+#pragma once
+// One interface for every broad phase the benchmark times: Bullet's, the
+// peers', the accelerator's and the cpu backend's. The benchmark's one
+// timing-and-validation loop drives them all.
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "types.hpp"
+
+namespace bpaccel {
+
+/// What a method is, which decides how its answer is judged.
+enum class MethodKind { Bullet, Peer, Accelerator, Cpu };
+
+/// The JSON and table spelling: bullet, peer, accelerator, cpu.
+std::string_view kindName(MethodKind kind);
+/// Exact kinds must return exactly the exact set: any difference fails the run.
+/// The others (Bullet, peers) may add pairs of padded boxes; a missing pair is
+/// a finding about that library, reported in the table.
+bool mustBeExact(MethodKind kind);
+
+/// Parts of a frame whose device and link are modelled, not measured.
+struct ModelledParts {
+  double hostSeconds = 0;      // measured on this machine
+  double deviceSeconds = 0;    // modelled: device cycles / clock
+  double transferSeconds = 0;  // modelled: link model
+  RunStats stats;              // the device's counters for the frame
+};
+
+/// What the table reports for one frame of a method.
+struct FrameTime {
+  double seconds = 0;
+  std::optional<ModelledParts> parts;
+};
+
+/// A broad phase as its users keep it across frames.
+class TimedMethod {
+ public:
+  virtual ~TimedMethod() = default;
+  /// The timed work of one frame: take this frame's boxes (same count and
+  /// order every frame) and find the overlapping pairs.
+  virtual void update(std::span<const Aabb> boxes) = 0;
+  /// The pairs of the last update (i < j, any order); not timed.
+  virtual void pairs(std::vector<Pair>& out) = 0;
+  /// The frame's time from the measured wall time of update(). Methods with a
+  /// modelled device replace the device's simulation by its model here.
+  virtual FrameTime frameTime(double measuredSeconds) const { return {measuredSeconds, std::nullopt}; }
+};
+
+/// What a method gets to build its structure (not timed as a frame).
+struct SceneStart {
+  std::span<const Aabb> boxes;  // the first frame's boxes
+  float worldMin = 0;           // every box of every frame stays inside
+  float worldMax = 0;           // [worldMin, worldMax] on each axis
+};
+
+/// One entry of the benchmark's line-up: how to name, skip and build a method.
+struct MethodSpec {
+  std::string name;
+  MethodKind kind = MethodKind::Peer;
+  std::string library;                  // e.g. "Bullet 3.24": the table's blocks per library
+  std::optional<std::size_t> cellSize;  // accelerator and cpu: the k-d tree's cell size
+  /// Why the method cannot run at this object count; nullopt when it can. May be empty.
+  std::function<std::optional<std::string>(std::size_t objects)> skipReason;
+  std::function<std::unique_ptr<TimedMethod>(const SceneStart&)> make;
+};
+
+/// The skip rule of methods that test all n(n-1)/2 pairs every frame: they
+/// are skipped where that exceeds `maxTestsPerFrame`.
+std::function<std::optional<std::string>(std::size_t objects)> allPairsSkipReason(double maxTestsPerFrame);
+
+}  // namespace bpaccel
