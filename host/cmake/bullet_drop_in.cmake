@@ -14,10 +14,8 @@ set(_bpaccel_src ${CMAKE_CURRENT_LIST_DIR}/../src)
 target_sources(bpaccel_core PUBLIC FILE_SET HEADERS BASE_DIRS ${_bpaccel_src} ${BPACCEL_VERILOG_DIR} FILES
   ${_bpaccel_src}/types.hpp ${_bpaccel_src}/all_pairs_kernel.hpp ${_bpaccel_src}/backend.hpp ${_bpaccel_src}/keys.hpp ${_bpaccel_src}/kd_tree.hpp
   ${_bpaccel_src}/broad_phase.hpp ${_bpaccel_src}/box_file.hpp ${BPACCEL_VERILOG_DIR}/bpaccel_params.h)
-# The source folder is a build-tree path: the file set carries it (build
-# interface) and installed users get include/ and include/bpaccel/.
-set_property(TARGET bpaccel_core PROPERTY INTERFACE_INCLUDE_DIRECTORIES
-  "$<BUILD_INTERFACE:${_bpaccel_src}>" "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>")
+# Installed users include <bpaccel/...> (the file set adds include/bpaccel/).
+target_include_directories(bpaccel_core INTERFACE $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
 set_target_properties(bpaccel_core PROPERTIES EXPORT_NAME core)
 
 add_library(bpaccel_bullet STATIC ${_bpaccel_src}/bullet_drop_in.cpp)
