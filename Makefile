@@ -23,7 +23,8 @@ BENCH_ARGS ?=
 # The FPGA flow's own test runs on this configuration.
 FPGA_TEST_VERILOG := build/fpga-verilog/test-m2
 
-.PHONY: all deps test test-hw test-host test-fpga host bench verilog fpga fpga-sweep clean
+.PHONY: all deps test test-hw test-host test-fpga host bench verilog fpga fpga-sweep clean \
+        host-sanitize test-sanitize fuzz test-fuzz fuzz-long
 
 all: test
 
@@ -58,6 +59,36 @@ bench: host
 	$(PYTHON) scripts/render_scene.py --json results/scene.json --out results/scene.png
 
 # FPGA flow (docs/fpga.md): ECP5 synthesis, place and route with a measured
+# The same host, Verilated model and tests under AddressSanitizer and
+# UndefinedBehaviorSanitizer (host/cmake/sanitize.cmake); any report fails.
+HOST_SANITIZE_BUILD := build/host-asan-$(ARCH_PREFIX)m$(M)-c$(CAPACITY)
+SANITIZER_ENV := ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1:strict_init_order=1 \
+                 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+host-sanitize: deps $(HOST_VERILOG)/filelist.f
+	cmake -S host -B $(HOST_SANITIZE_BUILD) -G Ninja -C host/cmake/sanitize.cmake \
+	  -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BIN_DIR=$(abspath $(HOST_SANITIZE_BUILD))/bin
+	cmake --build $(HOST_SANITIZE_BUILD) -j 2
+
+test-sanitize: host-sanitize
+	$(SANITIZER_ENV) ctest --test-dir $(HOST_SANITIZE_BUILD) --output-on-failure -j 2
+
+# libFuzzer targets on the box-file parser and the pair-finding API
+# (host/fuzz/README.md), built with clang, ASan and UBSan; no Verilator needed.
+FUZZ_BUILD   := build/fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_RUNS    ?= 1000000
+fuzz: deps
+	cmake -S host/fuzz -B $(FUZZ_BUILD) -G Ninja -DCMAKE_CXX_COMPILER=clang++
+	cmake --build $(FUZZ_BUILD) -j 2
+
+# A short run of each target (FUZZ_SECONDS each), part of `make test`.
+test-fuzz: fuzz
+	host/fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS)
+
+# The long run: FUZZ_RUNS executions of each target, one after the other.
+fuzz-long: fuzz
+	nice host/fuzz/run.sh --runs $(FUZZ_BUILD) $(FUZZ_RUNS)
+
 # Fmax, and a Xilinx 7-series synthesis estimate.
 fpga: deps
 	$(MAKE) verilog M=$(M) CAPACITY=$(CAPACITY) KEY_WIDTH=$(KEY_WIDTH) VERILOG_DIR=build/fpga-verilog/m$(M)

@@ -1,0 +1,201 @@
+// The pair-finding API on any scene decoded from the bytes: BroadPhase with
+// the cpu and the model backend, with and without a k-d tree, returns exactly
+// the pairs of a brute-force test on the floats, each once. Scenes mix
+// infinities, denormals, signed zeros, float extremes, a coarse integer grid
+// (touching faces), raw float bits and repeated boxes. The model runs with a
+// small m and capacity taken from the input, so cells are chunked often, and
+// on one or two threads.
+// A NaN coordinate must be refused with an InputError naming its box.
+//
+// Input layout (read front to back; missing bytes read as 0), so seeds can be
+// written by hand (host/fuzz/README.md):
+//   cell byte: 0 = no k-d tree, else cell size 1 + (byte - 1) % 40
+//   m byte: model lanes 1 + byte % 8, and with bit 7 set the model with the
+//   k-d tree also runs on 2 threads;  capacity byte: m * (1 + byte % (24/m + 1)), at least 2
+//   then records: op byte < 0x30 repeats an earlier box (op % count),
+//   any other op is followed by a box: per axis two coordinates, sorted.
+//   Coordinate byte k: k < 0x60 special value kSpecial[k % 24],
+//   k < 0xe0 grid value (k - 0x60) % 9 - 4, else 4 raw little-endian bytes.
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "backend.hpp"
+#include "broad_phase.hpp"
+#include "fuzz_check.hpp"
+#include "keys.hpp"
+#include "scenes.hpp"
+
+using namespace bpaccel;
+using bpaccel::fuzz::require;
+
+namespace {
+
+constexpr std::size_t kMaxBoxes = 192;
+
+// Values where float order, key order and the zero/infinity/denormal rules
+// meet: a coordinate often lands exactly on another box's face.
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kDenormMin = std::numeric_limits<float>::denorm_min();
+constexpr float kNormMin = std::numeric_limits<float>::min();
+constexpr float kMax = std::numeric_limits<float>::max();
+constexpr float kLargestDenorm = kNormMin - kDenormMin;
+constexpr float kSpecial[] = {-kInf, kInf, -0.0f, 0.0f, kDenormMin, -kDenormMin, 2 * kDenormMin, -2 * kDenormMin,
+                              kLargestDenorm, -kLargestDenorm, kNormMin, -kNormMin, kMax, -kMax, 1.0f, -1.0f,
+                              0.5f, 1.0000001f, 0.99999994f, 3e38f, -3e38f, 1e-38f, -1e-38f, 16777216.0f};
+
+// The fuzzer's bytes, read front to back; past the end every byte is 0.
+class ByteReader {
+ public:
+  ByteReader(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
+  bool empty() const { return pos_ >= size_; }
+  std::uint8_t byte() { return empty() ? 0 : data_[pos_++]; }
+  std::uint32_t word() {
+    std::uint32_t w = 0;
+    for (int shift = 0; shift < 32; shift += 8) w |= std::uint32_t{byte()} << shift;
+    return w;
+  }
+
+ private:
+  const std::uint8_t* data_;
+  std::size_t size_;
+  std::size_t pos_ = 0;
+};
+
+float coordinate(ByteReader& in) {
+  const std::uint8_t kind = in.byte();
+  if (kind < 0x60) return kSpecial[kind % std::size(kSpecial)];
+  if (kind < 0xe0) return static_cast<float>((kind - 0x60) % 9 - 4);  // a coarse grid: faces touch
+  return std::bit_cast<float>(in.word());                            // anything, NaN included
+}
+
+Aabb decodeBox(ByteReader& in) {
+  Aabb b{};
+  for (int a = 0; a < 3; ++a) {
+    const float x = coordinate(in), y = coordinate(in);
+    // Ordered so min <= max; equal values (such as -0 and +0) keep the order
+    // they came in, so both zero orders occur. NaN stays where it fell.
+    const bool swap = y < x;
+    b.min[a] = swap ? y : x;
+    b.max[a] = swap ? x : y;
+  }
+  return b;
+}
+
+std::vector<Aabb> decodeScene(ByteReader& in) {
+  std::vector<Aabb> boxes;
+  while (!in.empty() && boxes.size() < kMaxBoxes) {
+    const std::uint8_t op = in.byte();
+    if (op < 0x30 && !boxes.empty())
+      boxes.push_back(boxes[op % boxes.size()]);  // an identical box
+    else
+      boxes.push_back(decodeBox(in));
+  }
+  return boxes;
+}
+
+std::optional<std::size_t> firstBoxWithNaN(const std::vector<Aabb>& boxes) {
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    for (int a = 0; a < 3; ++a)
+      if (std::isnan(boxes[i].min[a]) || std::isnan(boxes[i].max[a])) return i;
+  return std::nullopt;
+}
+
+// One configuration under test: a backend, a cell size and a thread count.
+struct Setup {
+  std::string label;
+  std::function<std::unique_ptr<BroadPhase>()> make;
+};
+
+void checkExact(const Setup& setup, const std::vector<Aabb>& boxes, const std::vector<Pair>& expected) {
+  const auto broadPhase = setup.make();
+  std::vector<Pair> pairs;
+  broadPhase->findPairs(boxes, pairs);
+  for (const auto& [i, j] : pairs)
+    require(i < j && j < boxes.size(), fmt::format("{}: bad pair ({}, {})", setup.label, i, j));
+  // Equal to the duplicate-free reference once sorted: every pair exactly once.
+  const std::vector<Pair> got = testing::sorted(std::move(pairs));
+  if (got == expected) return;
+  const auto missing = std::find_if(expected.begin(), expected.end(),
+                                    [&](const Pair& p) { return !std::binary_search(got.begin(), got.end(), p); });
+  require(false, fmt::format("{} on {} boxes: {} pairs, expected {}{}", setup.label, boxes.size(), got.size(),
+                             expected.size(),
+                             missing == expected.end()
+                                 ? std::string(" (an extra or repeated pair)")
+                                 : fmt::format(" (missing {} {})", missing->first, missing->second)));
+}
+
+void checkRefused(const Setup& setup, const std::vector<Aabb>& boxes, std::size_t badBox) {
+  const auto broadPhase = setup.make();
+  std::vector<Pair> pairs;
+  try {
+    broadPhase->findPairs(boxes, pairs);
+  } catch (const InputError& e) {
+    require(e.object() == badBox, fmt::format("{}: NaN in box {} reported as {}", setup.label, badBox, e.what()));
+    return;
+  }
+  require(false, fmt::format("{}: NaN in box {} accepted", setup.label, badBox));
+}
+
+// The key map's contract on the scene's own values: float order is key order.
+void checkKeyOrder(const std::vector<Aabb>& boxes) {
+  std::vector<float> values;
+  for (const Aabb& b : boxes)
+    for (int a = 0; a < 3; ++a)
+      for (float v : {b.min[a], b.max[a]})
+        if (!std::isnan(v)) values.push_back(v);
+  for (std::size_t t = 1; t < values.size(); ++t) {
+    const float x = values[t - 1], y = values[t];
+    const std::uint32_t kx = floatToKey(x), ky = floatToKey(y);
+    require((x < y) == (kx < ky) && (x == y) == (kx == ky),
+            fmt::format("keys {:#x} {:#x} misorder {} {}", kx, ky, x, y));
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  ByteReader in(data, size);
+  const std::uint8_t cellByte = in.byte();
+  const std::optional<std::size_t> cell =
+      cellByte == 0 ? std::nullopt : std::optional<std::size_t>(1 + (cellByte - 1) % 40);
+  const std::uint8_t mByte = in.byte();
+  const std::size_t m = 1 + mByte % 8;
+  const std::size_t threads = mByte & 0x80 ? 2 : 1;
+  const std::size_t capacity = std::max<std::size_t>(2, m * (1 + in.byte() % (24 / m + 1)));
+  const std::vector<Aabb> boxes = decodeScene(in);
+
+  CpuBackend cpu;
+  ModelBackend model(m, capacity, /*runOverheadCycles=*/3);
+  std::vector<Setup> setups;
+  for (const auto& c : {std::optional<std::size_t>{}, cell}) {
+    const std::string cellName = c ? std::to_string(*c) : "none";
+    setups.push_back({"cpu cell " + cellName, [&cpu, c] { return std::make_unique<BroadPhase>(cpu, c); }});
+    setups.push_back({fmt::format("model m {} capacity {} cell {}", m, capacity, cellName),
+                      [&model, c] { return std::make_unique<BroadPhase>(model, c); }});
+  }
+  if (threads > 1 && cell) {
+    const auto makeModel = [m, capacity]() -> std::unique_ptr<Backend> {
+      return std::make_unique<ModelBackend>(m, capacity, 3);
+    };
+    setups.push_back({fmt::format("model m {} capacity {} cell {} threads {}", m, capacity, *cell, threads),
+                      [makeModel, cell, threads] { return std::make_unique<BroadPhase>(makeModel, cell, threads); }});
+  }
+  if (const auto bad = firstBoxWithNaN(boxes)) {
+    for (const Setup& setup : setups) checkRefused(setup, boxes, *bad);
+    return 0;
+  }
+  checkKeyOrder(boxes);
+  const std::vector<Pair> expected = testing::bruteForce(boxes);
+  for (const Setup& setup : setups) checkExact(setup, boxes, expected);
+  return 0;
+}

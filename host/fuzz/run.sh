@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Runs every fuzz target of build dir $1, one after the other, either for $2
+# seconds each (time mode) or for $2 executions each (--runs mode). Each
+# starts from the committed seeds (host/fuzz/corpus/<target>, never written)
+# plus a working corpus in the build dir, so every committed reproducer is
+# replayed first. Any crash, sanitizer report, failed property or input
+# slower than 10 s fails the script, leaving the input in <build>/artifacts.
+#   run.sh BUILD_DIR SECONDS        run.sh --runs BUILD_DIR EXECUTIONS
+set -euo pipefail
+mode=-max_total_time
+if [ "${1:-}" = "--runs" ]; then mode=-runs; shift; fi
+build=${1:?build dir}
+amount=${2:?seconds or executions}
+here=$(cd "$(dirname "$0")" && pwd)
+
+mkdir -p "$build/artifacts"
+for target in box_file pairs; do
+  work="$build/work/$target"
+  mkdir -p "$work"
+  dict=()
+  [ -f "$here/$target.dict" ] && dict=(-dict="$here/$target.dict")
+  log="$build/$target.log"
+  echo "fuzz: $target ($mode=$amount), log in $log"
+  status=0
+  "$build/${target}_fuzzer" "$mode=$amount" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+    -artifact_prefix="$build/artifacts/$target-" "${dict[@]}" "$work" "$here/corpus/$target" >"$log" 2>&1 ||
+    status=$?
+  grep -E '^(Done|stat::number_of_executed_units|stat::average_exec_per_sec)' "$log" | sed "s/^/fuzz: $target: /" || true
+  if [ $status -ne 0 ]; then
+    tail -n 40 "$log" >&2
+    echo "fuzz: $target FAILED (exit $status); the input is in $build/artifacts/, replay it with" \
+      "$build/${target}_fuzzer <file>" >&2
+    exit 1
+  fi
+done
