@@ -193,8 +193,11 @@ void Broadphase::calculateOverlappingPairs(btDispatcher* dispatcher) {
   std::size_t i = 0, j = 0;
   while (i < found_.size() || j < cached_.size()) {
     if (j == cached_.size() || (i < found_.size() && found_[i] < cached_[j])) {
-      cache_->addOverlappingPair(slots_[found_[i].first].get(), slots_[found_[i].second].get());
-      ++report_.added;
+      // The cache's filter may refuse the pair; it is offered again next frame, as btSimpleBroadphase does.
+      if (cache_->addOverlappingPair(slots_[found_[i].first].get(), slots_[found_[i].second].get()) != nullptr)
+        ++report_.added;
+      else
+        ++report_.refused;
       ++i;
     } else if (i == found_.size() || cached_[j] < found_[i]) {
       if (deferred)
@@ -253,11 +256,11 @@ void Broadphase::resetPool(btDispatcher* /*dispatcher*/) {
 void Broadphase::printStats() {
   const RunStats& s = broadPhase_.stats();
   fmt::print("bpaccel::Broadphase: backend {} cell size {}, {} proxies, {} cached pairs\n"
-             "  last frame: {} overlaps, {} added, {} removed, find {:.6f} s, cache {:.6f} s\n"
+             "  last frame: {} overlaps, {} added, {} refused by the filter, {} removed, find {:.6f} s, cache {:.6f} s\n"
              "  all frames: {} runs, {} device cycles, {} hits\n",
              backend_->name(), options_.cellSize ? fmt::format("{}", *options_.cellSize) : std::string("none"),
-             boxes_.size(), cache_->getNumOverlappingPairs(), report_.overlaps, report_.added, report_.removed,
-             report_.findSeconds, report_.cacheSeconds, s.runs, s.deviceCycles(), s.hits);
+             boxes_.size(), cache_->getNumOverlappingPairs(), report_.overlaps, report_.added, report_.refused,
+             report_.removed, report_.findSeconds, report_.cacheSeconds, s.runs, s.deviceCycles(), s.hits);
 }
 
 }  // namespace bpaccel

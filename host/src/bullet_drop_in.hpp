@@ -38,7 +38,8 @@ struct BroadphaseOptions {
 struct FrameReport {
   std::size_t proxies = 0;
   std::size_t overlaps = 0;         // overlapping proxy pairs found (before the cache's filter)
-  std::size_t added = 0;            // addOverlappingPair calls for pairs that began to overlap
+  std::size_t added = 0;            // pairs that began to overlap and that the cache took
+  std::size_t refused = 0;          // overlapping pairs the cache's filter refused (offered every frame)
   std::size_t removed = 0;          // removeOverlappingPair calls for pairs that ended
   double findSeconds = 0;           // BroadPhase::findPairs (host and backend)
   double cacheSeconds = 0;          // ordering the pairs, diffing with the cache, add/remove calls

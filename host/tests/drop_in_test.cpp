@@ -404,6 +404,8 @@ TEST(DropIn, CollisionFilterGroupsMasksAndCallbackDecide) {
   EXPECT_NE(cache->findPair(c, d), nullptr);
   EXPECT_EQ(cache->findPair(a, d), nullptr);
   EXPECT_EQ(cache->getNumOverlappingPairs(), 2);
+  EXPECT_EQ(bp.lastFrame().added, 2u);
+  EXPECT_EQ(bp.lastFrame().refused, 4u);  // a-c, b-c, a-d, b-d
 
   // A filter callback replaces the group/mask test for pairs added after it is set.
   struct RejectB : btOverlapFilterCallback {
@@ -445,7 +447,11 @@ TEST(DropIn, UsesTheCacheItIsGiven) {
     bp.setAabb(b, btVector3(3, 3, 3), btVector3(4, 4, 4), &fx.dispatcher);
     bp.calculateOverlappingPairs(&fx.dispatcher);
     EXPECT_EQ(cache->getNumOverlappingPairs(), 0);
+    bp.setAabb(b, btVector3(0.5f, 0.5f, 0.5f), btVector3(2, 2, 2), &fx.dispatcher);
+    bp.calculateOverlappingPairs(&fx.dispatcher);
+    EXPECT_EQ(cache->getNumOverlappingPairs(), 1);
     bp.destroyProxy(a, &fx.dispatcher);
+    EXPECT_EQ(cache->getNumOverlappingPairs(), 0);
     bp.destroyProxy(b, &fx.dispatcher);
   }
 }
@@ -606,7 +612,7 @@ TEST(DropIn, PrintStatsNamesBackendProxiesAndPairs) {
   bp.printStats();
   const std::string text = ::testing::internal::GetCapturedStdout();
   EXPECT_NE(text.find("backend model cell size 16, 3 proxies, 1 cached pairs"), std::string::npos) << text;
-  EXPECT_NE(text.find("1 overlaps, 1 added, 0 removed"), std::string::npos) << text;
+  EXPECT_NE(text.find("1 overlaps, 1 added, 0 refused by the filter, 0 removed"), std::string::npos) << text;
 }
 
 TEST(DropIn, WholeStepTimingStepsTheBouncingCube) {
