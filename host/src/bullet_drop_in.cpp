@@ -111,6 +111,9 @@ btBroadphaseProxy* Broadphase::createProxy(const btVector3& aabbMin, const btVec
 void Broadphase::destroyProxy(btBroadphaseProxy* proxy, btDispatcher* dispatcher) {
   Proxy& p = owned(proxy, "destroyProxy");
   cache_->removeOverlappingPairsContainingProxy(&p, dispatcher);
+  std::erase_if(present_, [slot = p.slot](std::uint64_t key) {
+    return key >> 32 == slot || (key & 0xFFFFFFFFu) == slot;
+  });
   // Swap-remove from the dense arrays, moving the last box into the hole.
   const std::uint32_t last = static_cast<std::uint32_t>(boxes_.size() - 1);
   const std::uint32_t movedSlot = denseSlot_[last];
@@ -166,54 +169,69 @@ void Broadphase::calculateOverlappingPairs(btDispatcher* dispatcher) {
   const auto found = Clock::now();
   report_.findSeconds = std::chrono::duration<double>(found - start).count();
 
-  // Both sets as (lower slot, higher slot), sorted: the backend's pair order
-  // never reaches Bullet, and changes go to the cache in one fixed order.
-  for (Pair& pair : found_) {
-    const std::uint32_t a = denseSlot_[pair.first], b = denseSlot_[pair.second];
-    pair = {std::min(a, b), std::max(a, b)};
-  }
-  std::sort(found_.begin(), found_.end());
-  // The cache itself is the previous frame's set: pairs the world removed (a
-  // destroyed object's) come back while they overlap, as with btSimpleBroadphase.
-  const btBroadphasePairArray& array = cache_->getOverlappingPairArray();
-  cached_.clear();
-  cached_.reserve(static_cast<std::size_t>(array.size()));
-  for (int k = 0; k < array.size(); ++k) {
-    const std::uint32_t a = owned(array[k].m_pProxy0, "pair cache").slot;
-    const std::uint32_t b = owned(array[k].m_pProxy1, "pair cache").slot;
-    cached_.emplace_back(std::min(a, b), std::max(a, b));
-  }
-  std::sort(cached_.begin(), cached_.end());
+  // Pairs as 64-bit keys (lower slot, higher slot), sorted: the backend's
+  // pair order never reaches Bullet, and changes go to the cache in one fixed order.
+  foundKeys_.resize(found_.size());
+  for (std::size_t k = 0; k < found_.size(); ++k)
+    foundKeys_[k] = pairKey(denseSlot_[found_[k].first], denseSlot_[found_[k].second]);
+  std::sort(foundKeys_.begin(), foundKeys_.end());
+  // present_ is what the cache held after the last frame. Other code may have
+  // changed the cache since (removed a pair, say): then its count differs and
+  // the cache itself is read, so removed pairs come back while they overlap,
+  // as with btSimpleBroadphase.
+  if (static_cast<std::size_t>(cache_->getNumOverlappingPairs()) != present_.size()) rereadCache();
 
   // A cache with deferred removal (btSortedOverlappingPairCache) ignores
   // removeOverlappingPair: the broad phase cleans the ended pairs and compacts
   // the array itself, as btDbvtBroadphase::performDeferredRemoval does.
   const bool deferred = cache_->hasDeferredRemoval();
   ended_.clear();
+  next_.clear();
   std::size_t i = 0, j = 0;
-  while (i < found_.size() || j < cached_.size()) {
-    if (j == cached_.size() || (i < found_.size() && found_[i] < cached_[j])) {
+  while (i < foundKeys_.size() || j < present_.size()) {
+    if (j == present_.size() || (i < foundKeys_.size() && foundKeys_[i] < present_[j])) {
       // The cache's filter may refuse the pair; it is offered again next frame, as btSimpleBroadphase does.
-      if (cache_->addOverlappingPair(slots_[found_[i].first].get(), slots_[found_[i].second].get()) != nullptr)
+      if (cache_->addOverlappingPair(proxyOf(foundKeys_[i] >> 32), proxyOf(foundKeys_[i] & 0xFFFFFFFFu)) != nullptr) {
+        next_.push_back(foundKeys_[i]);
         ++report_.added;
-      else
+      } else {
         ++report_.refused;
+      }
       ++i;
-    } else if (i == found_.size() || cached_[j] < found_[i]) {
+    } else if (i == foundKeys_.size() || present_[j] < foundKeys_[i]) {
       if (deferred)
-        ended_.push_back(cached_[j]);
+        ended_.push_back(present_[j]);
       else
-        cache_->removeOverlappingPair(slots_[cached_[j].first].get(), slots_[cached_[j].second].get(), dispatcher);
+        cache_->removeOverlappingPair(proxyOf(present_[j] >> 32), proxyOf(present_[j] & 0xFFFFFFFFu), dispatcher);
       ++report_.removed;
       ++j;
     } else {
+      next_.push_back(present_[j]);
       ++i;
       ++j;
     }
   }
+  present_.swap(next_);
   if (deferred) removeDeferred(dispatcher);
   report_.cacheSeconds = secondsSince(found);
   report_.totalSeconds = secondsSince(start);
+}
+
+std::uint64_t Broadphase::pairKey(std::uint32_t slotA, std::uint32_t slotB) {
+  return static_cast<std::uint64_t>(std::min(slotA, slotB)) << 32 | std::max(slotA, slotB);
+}
+
+std::uint64_t Broadphase::cachedKey(const btBroadphasePair& pair) const {
+  return pairKey(owned(pair.m_pProxy0, "pair cache").slot, owned(pair.m_pProxy1, "pair cache").slot);
+}
+
+btBroadphaseProxy* Broadphase::proxyOf(std::uint64_t slot) const { return slots_[slot].get(); }
+
+void Broadphase::rereadCache() {
+  const btBroadphasePairArray& array = cache_->getOverlappingPairArray();
+  present_.resize(static_cast<std::size_t>(array.size()));
+  for (int k = 0; k < array.size(); ++k) present_[static_cast<std::size_t>(k)] = cachedKey(array[k]);
+  std::sort(present_.begin(), present_.end());
 }
 
 void Broadphase::removeDeferred(btDispatcher* dispatcher) {
@@ -221,8 +239,7 @@ void Broadphase::removeDeferred(btDispatcher* dispatcher) {
   int invalid = 0;
   for (int k = 0; k < array.size(); ++k) {
     btBroadphasePair& pair = array[k];
-    const std::uint32_t a = owned(pair.m_pProxy0, "pair cache").slot, b = owned(pair.m_pProxy1, "pair cache").slot;
-    if (!std::binary_search(ended_.begin(), ended_.end(), Pair{std::min(a, b), std::max(a, b)})) continue;
+    if (!std::binary_search(ended_.begin(), ended_.end(), cachedKey(pair))) continue;
     cache_->cleanOverlappingPair(pair, dispatcher);
     pair.m_pProxy0 = nullptr;
     pair.m_pProxy1 = nullptr;
@@ -249,6 +266,7 @@ void Broadphase::getBroadphaseAabb(btVector3& aabbMin, btVector3& aabbMax) const
 
 void Broadphase::resetPool(btDispatcher* /*dispatcher*/) {
   if (!boxes_.empty()) return;
+  present_.clear();
   slots_.clear();
   freeSlots_.clear();
 }

@@ -100,6 +100,10 @@ class Broadphase final : public btBroadphaseInterface {
  private:
   struct Proxy;
   Proxy& owned(btBroadphaseProxy* proxy, const char* what) const;
+  static std::uint64_t pairKey(std::uint32_t slotA, std::uint32_t slotB);
+  std::uint64_t cachedKey(const btBroadphasePair& pair) const;
+  btBroadphaseProxy* proxyOf(std::uint64_t slot) const;
+  void rereadCache();
   void removeDeferred(btDispatcher* dispatcher);
   static Aabb checkedBox(const btVector3& aabbMin, const btVector3& aabbMax, const Proxy* proxy, const char* what);
 
@@ -112,9 +116,12 @@ class Broadphase final : public btBroadphaseInterface {
   std::vector<std::uint32_t> freeSlots_;        // destroyed slots, the last one reused first
   std::vector<Aabb> boxes_;                     // live proxies' boxes, dense (what BroadPhase sees)
   std::vector<std::uint32_t> denseSlot_;        // slot of each dense box
-  std::vector<Pair> found_;                     // this frame's pairs: dense, then slots
-  std::vector<Pair> cached_;                    // the cache's pairs as slots
-  std::vector<Pair> ended_;                     // pairs to drop from a cache with deferred removal
+  // Pairs of slots as keys (lower << 32 | higher), sorted.
+  std::vector<Pair> found_;                     // this frame's pairs, dense indices
+  std::vector<std::uint64_t> foundKeys_;        // the same as slot keys
+  std::vector<std::uint64_t> present_;          // the cache's pairs after the last frame
+  std::vector<std::uint64_t> next_;             // present_ being rebuilt
+  std::vector<std::uint64_t> ended_;            // pairs to drop from a cache with deferred removal
   FrameReport report_;
 };
 

@@ -386,6 +386,12 @@ TEST(DropIn, PairsBeginAndEndIncrementallyAndLeaveWithTheirProxy) {
   bp.calculateOverlappingPairs(&fx.dispatcher);
   EXPECT_NE(bp.getOverlappingPairCache()->findPair(b, d), nullptr);
   EXPECT_EQ(bp.proxyCount(), 3u);
+
+  // A pair removed from the cache by other code comes back while it overlaps.
+  bp.getOverlappingPairCache()->removeOverlappingPair(b, d, &fx.dispatcher);
+  bp.calculateOverlappingPairs(&fx.dispatcher);
+  EXPECT_NE(bp.getOverlappingPairCache()->findPair(b, d), nullptr);
+  EXPECT_EQ(bp.lastFrame().added, 1u);
 }
 
 TEST(DropIn, CollisionFilterGroupsMasksAndCallbackDecide) {
