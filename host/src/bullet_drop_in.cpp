@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
+#include <limits>
 #include <type_traits>
 
 #include <BulletCollision/BroadphaseCollision/btOverlappingPairCache.h>
 #include <LinearMath/btAabbUtil2.h>
 #include <fmt/format.h>
+
+#include "keys.hpp"
 
 namespace bpaccel {
 
@@ -64,13 +66,19 @@ Broadphase::Proxy& Broadphase::owned(btBroadphaseProxy* proxy, const char* what)
 
 Aabb Broadphase::checkedBox(const btVector3& aabbMin, const btVector3& aabbMax, const Proxy* proxy, const char* what) {
   static constexpr char kAxis[3] = {'x', 'y', 'z'};
+  // Tested on keys, not floats: -ffast-math builds may fold isnan and float
+  // compares with NaN. NaN keys lie outside [key(-inf), key(+inf)].
+  static const std::uint32_t kLowest = floatToKey(-std::numeric_limits<float>::infinity());
+  static const std::uint32_t kHighest = floatToKey(std::numeric_limits<float>::infinity());
+  auto isNaN = [](std::uint32_t key) { return key < kLowest || key > kHighest; };
   Aabb box{};
   for (int a = 0; a < 3; ++a) {
     const float lo = aabbMin[a], hi = aabbMax[a];
-    if (std::isnan(lo) || std::isnan(hi))
+    const std::uint32_t loKey = floatToKey(lo), hiKey = floatToKey(hi);
+    if (isNaN(loKey) || isNaN(hiKey))
       throw BroadphaseError(fmt::format("{}: {} has NaN in its AABB on {} (min {}, max {})", what, describe(proxy),
                                         kAxis[a], lo, hi));
-    if (lo > hi)
+    if (loKey > hiKey)
       throw BroadphaseError(fmt::format("{}: {} has min {} > max {} on {}", what, describe(proxy), lo, hi, kAxis[a]));
     box.min[static_cast<std::size_t>(a)] = lo;
     box.max[static_cast<std::size_t>(a)] = hi;
