@@ -30,6 +30,8 @@ struct BroadPhase::Worker {
   std::vector<Pair> out;                // this worker's share of the frame's pairs
   RunStats stats;
   double backendSeconds = 0;
+  Clock::time_point frameStart;
+  std::vector<RunRecord> runs;
 
   void runBatch(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, const KdTree::Leaf* region,
                 std::size_t splitAt, int keep);
@@ -88,6 +90,7 @@ void BroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) 
   findPairs(std::span<const KeyBox>(keys_), out);
   times_.convertSeconds = convert;
   times_.totalSeconds += convert;
+  for (RunRecord& r : runs_) r.readySeconds += convert;  // the conversion came first
 }
 
 void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out) {
@@ -100,20 +103,22 @@ void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out)
     tree_.build(keys, *cellSize_);
     const auto t1 = Clock::now();
     times_.treeSeconds = seconds(t0, t1);
-    processCells(keys, out);
+    processCells(keys, out, t0);
     times_.cellsSeconds = seconds(t1, Clock::now());
   } else {
-    processCells(keys, out);
+    processCells(keys, out, t0);
     times_.cellsSeconds = seconds(t0, Clock::now());
   }
   times_.totalSeconds = times_.treeSeconds + times_.cellsSeconds;
 }
 
-void BroadPhase::processCells(std::span<const KeyBox> keys, std::vector<Pair>& out) {
+void BroadPhase::processCells(std::span<const KeyBox> keys, std::vector<Pair>& out, Clock::time_point start) {
   for (auto& w : workers_) {
     w->out.clear();
     w->stats = {};
     w->backendSeconds = 0;
+    w->frameStart = start;
+    w->runs.clear();
   }
   if (!cellSize_) {
     identity_.resize(keys.size());
@@ -131,10 +136,12 @@ void BroadPhase::processCells(std::span<const KeyBox> keys, std::vector<Pair>& o
       });
     });
   }
+  runs_.clear();
   for (auto& w : workers_) {
     out.insert(out.end(), w->out.begin(), w->out.end());
     stats_ += w->stats;
     times_.backendSeconds += w->backendSeconds;
+    runs_.insert(runs_.end(), w->runs.begin(), w->runs.end());
   }
 }
 
@@ -171,9 +178,13 @@ void BroadPhase::Worker::runBatch(std::span<const KeyBox> keys, std::span<const 
   batch.resize(items.size());
   for (std::size_t t = 0; t < items.size(); ++t) batch[t] = keys[items[t]];
   local.clear();
-  const auto t0 = Clock::now();
-  backend->run(batch, local, stats);
-  backendSeconds += seconds(t0, Clock::now());
+  RunRecord record;
+  const auto packed = Clock::now();
+  record.readySeconds = seconds(frameStart, packed) - backendSeconds;
+  backend->run(batch, local, record.stats);
+  const auto ran = Clock::now();
+  backendSeconds += seconds(packed, ran);
+  stats += record.stats;
   for (const auto& [a, b] : local) {
     const bool firstA = a < splitAt, firstB = b < splitAt;
     const int kind = firstA != firstB ? kCross : (firstA ? kFirstInside : kSecondInside);
@@ -182,6 +193,8 @@ void BroadPhase::Worker::runBatch(std::span<const KeyBox> keys, std::span<const 
     const std::uint32_t i = items[a], j = items[b];
     out.emplace_back(std::min(i, j), std::max(i, j));
   }
+  record.decodeSeconds = seconds(ran, Clock::now());
+  runs.push_back(record);
 }
 
 }  // namespace bpaccel

@@ -10,6 +10,7 @@
 
 #include "backend.hpp"
 #include "kd_tree.hpp"
+#include "timeline.hpp"
 #include "types.hpp"
 
 namespace bpaccel {
@@ -53,11 +54,15 @@ class BroadPhase {
   const HostTimes& times() const { return times_; }
   const KdTree& tree() const { return tree_; }
   std::size_t threads() const { return workers_.size(); }
+  /// The last call's backend runs in order, with the measured host time at
+  /// which each was ready and its decoding took (for modelPipeline). With
+  /// several threads, each worker's runs follow the previous worker's.
+  const std::vector<RunRecord>& runs() const { return runs_; }
 
  private:
   struct Worker;
   class Pool;
-  void processCells(std::span<const KeyBox> keys, std::vector<Pair>& out);
+  void processCells(std::span<const KeyBox> keys, std::vector<Pair>& out, std::chrono::steady_clock::time_point start);
   void check() const;
 
   std::vector<std::unique_ptr<Worker>> workers_;
@@ -69,6 +74,7 @@ class BroadPhase {
   std::vector<std::uint32_t> identity_;  // 0..n-1: the scene as one cell
   RunStats stats_;
   HostTimes times_;
+  std::vector<RunRecord> runs_;
 };
 
 }  // namespace bpaccel

@@ -4,6 +4,7 @@
 #include <set>
 
 #include "all_pairs_kernel.hpp"
+#include "timeline.hpp"
 #include "backend.hpp"
 #include "broad_phase.hpp"
 #include "bpaccel_params.h"
@@ -209,4 +210,85 @@ TEST(BroadPhase, SeveralThreadsGiveExactlyTheSinglePairs) {
 TEST(BroadPhase, RejectsZeroThreadsAndAnEmptyFactory) {
   EXPECT_THROW(BroadPhase([] { return std::make_unique<CpuBackend>(); }, 8, 0), std::invalid_argument);
   EXPECT_THROW(BroadPhase([] { return std::unique_ptr<Backend>(); }, 8, 2), std::invalid_argument);
+}
+
+TEST(ModelPipeline, OverlapsHostLinkAndDeviceAsWorkedOutByHand) {
+  // 1 us a cycle, one box (24 bytes) a microsecond on the link, one beat a microsecond.
+  PipelineModel model{1e6, 24e6, 0, 24, 24};
+  RunRecord first, second;
+  first.readySeconds = 10e-6;
+  first.decodeSeconds = 2e-6;
+  first.stats.boxesSent = 4;
+  first.stats.loadCycles = 5;  // the port, not the link, bounds the load: 5 us
+  first.stats.cycles = 20;
+  first.stats.beatsReceived = 3;
+  second.readySeconds = 12e-6;  // measured after the first run's 2 us decode: ready at 10 us without it
+  second.decodeSeconds = 1e-6;
+  second.stats.boxesSent = 2;
+  second.stats.loadCycles = 3;
+  second.stats.cycles = 10;
+  const double host = 15e-6;
+  auto t = modelPipeline({first, second}, host, model);
+  // First: device 10..35 us, decoded 35..37. Second waits for the device: 35..48, decoded 48..49.
+  EXPECT_NEAR(t.producerSeconds, 12e-6, 1e-12);
+  EXPECT_NEAR(t.device[0].start, 10e-6, 1e-12);
+  EXPECT_NEAR(t.device[0].end, 35e-6, 1e-12);
+  EXPECT_NEAR(t.device[1].start, 35e-6, 1e-12);
+  EXPECT_NEAR(t.decode[1].end, 49e-6, 1e-12);
+  EXPECT_NEAR(t.frameSeconds, 49e-6, 1e-12);
+  // A latency each way: the first starts at 11 and completes at 37; the second starts at 36.
+  model.latencySeconds = 1e-6;
+  t = modelPipeline({first, second}, host, model);
+  EXPECT_NEAR(t.decode[0].start, 37e-6, 1e-12);
+  EXPECT_NEAR(t.device[1].start, 36e-6, 1e-12);
+  EXPECT_NEAR(t.frameSeconds, 51e-6, 1e-12);
+}
+
+TEST(ModelPipeline, NeverBeatsTheBusiestLaneNorLosesToTheSerialSum) {
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> us(0, 5e-6);
+  const PipelineModel model{100e6, 4e9, 1e-6, 24, 4};
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<RunRecord> runs(1 + rng() % 30);
+    double ready = 0, host = 0, device = 0, serial = 0;
+    for (auto& r : runs) {
+      ready += us(rng);
+      r.readySeconds = ready + host;  // the serial run's clock includes earlier decodes
+      r.decodeSeconds = us(rng);
+      host += r.decodeSeconds;
+      r.stats.boxesSent = rng() % 300;
+      r.stats.loadCycles = r.stats.boxesSent + 1;
+      r.stats.cycles = rng() % 5000;
+      r.stats.beatsReceived = rng() % 100;
+      const double load = std::max(24.0 * r.stats.boxesSent / 4e9, r.stats.loadCycles / 100e6);
+      device += load + r.stats.cycles / 100e6;
+      serial += 2e-6 + load + r.stats.cycles / 100e6 + 4.0 * r.stats.beatsReceived / 4e9;
+    }
+    host += ready + us(rng);
+    const auto t = modelPipeline(runs, host, model);
+    EXPECT_GE(t.frameSeconds + 1e-15, device);
+    EXPECT_GE(t.frameSeconds + 1e-15, t.producerSeconds);
+    EXPECT_LE(t.frameSeconds, host + serial + 1e-12);
+  }
+}
+
+TEST(BroadPhase, RecordsEveryRunInOrderWithItsOwnCounters) {
+  ModelBackend small(4, 64, 5);
+  BroadPhase bp(small, 16);
+  std::vector<Pair> pairs;
+  const auto boxes = adversarialScenes(500, 21).front().second;
+  bp.findPairs(boxes, pairs);
+  ASSERT_EQ(bp.runs().size(), bp.stats().runs);
+  RunStats sum;
+  double last = 0;
+  for (const auto& r : bp.runs()) {
+    sum += r.stats;
+    EXPECT_GE(r.readySeconds, last);
+    EXPECT_GE(r.decodeSeconds, 0);
+    last = r.readySeconds;
+  }
+  EXPECT_EQ(sum.cycles, bp.stats().cycles);
+  EXPECT_EQ(sum.loadCycles, bp.stats().loadCycles);
+  EXPECT_EQ(sum.boxesSent, bp.stats().boxesSent);
+  EXPECT_LE(last, bp.times().totalSeconds);
 }

@@ -1,0 +1,44 @@
+#include "timeline.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace bpaccel {
+
+FrameTimeline modelPipeline(const std::vector<RunRecord>& runs, double hostSeconds, const PipelineModel& model) {
+  if (!(model.clockHz > 0) || !(model.bandwidthBytesPerSecond > 0) || model.latencySeconds < 0)
+    throw std::invalid_argument("pipeline model: clock and bandwidth must be positive, latency not negative");
+  FrameTimeline t;
+  double decodedBefore = 0;  // decoding the serial run did before this run was ready
+  double linkFree = 0, deviceFree = 0, decodeFree = 0, produceStart = 0;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const RunRecord& r = runs[i];
+    const RunStats& s = r.stats;
+    // The producer no longer decodes: each run is ready that much earlier.
+    const double ready = std::max(0.0, r.readySeconds - decodedBefore);
+    decodedBefore += r.decodeSeconds;
+    t.produce.push_back({produceStart, ready, i});
+    produceStart = ready;
+
+    const double boxes = model.bytesPerBox * static_cast<double>(s.boxesSent) / model.bandwidthBytesPerSecond;
+    const double load = std::max(boxes, static_cast<double>(s.loadCycles) / model.clockHz);
+    const double compute = static_cast<double>(s.cycles) / model.clockHz;
+    const double results = model.bytesPerBeat * static_cast<double>(s.beatsReceived) / model.bandwidthBytesPerSecond;
+    const double start = std::max({ready + model.latencySeconds, linkFree, deviceFree});
+    t.link.push_back({start, start + boxes, i});
+    if (results > 0) t.link.push_back({start + load, start + load + results, i});
+    t.device.push_back({start, start + load + compute, i});
+    deviceFree = start + load + compute;
+    linkFree = std::max(start + boxes, start + load + results);
+    const double arrived = std::max(deviceFree, start + load + results) + model.latencySeconds;
+    const double decodeStart = std::max(arrived, decodeFree);
+    decodeFree = decodeStart + r.decodeSeconds;
+    t.decode.push_back({decodeStart, decodeFree, i});
+  }
+  t.producerSeconds = std::max(produceStart, hostSeconds - decodedBefore);
+  if (t.producerSeconds > produceStart) t.produce.push_back({produceStart, t.producerSeconds, runs.size()});
+  t.frameSeconds = std::max(decodeFree, t.producerSeconds);
+  return t;
+}
+
+}  // namespace bpaccel

@@ -1,0 +1,54 @@
+#pragma once
+// A frame of the accelerated broad phase as a pipeline: the host's measured
+// work, a modelled link and a modelled device, overlapped.
+
+#include <cstddef>
+#include <vector>
+
+#include "types.hpp"
+
+namespace bpaccel {
+
+/// One backend run of a frame, as BroadPhase recorded it.
+struct RunRecord {
+  /// Measured: host time from the frame's start until this run's boxes were
+  /// packed, with the device's simulation taken out.
+  double readySeconds = 0;
+  /// Measured: host time to decode and filter this run's pairs.
+  double decodeSeconds = 0;
+  RunStats stats;  // this run's counters (cycles from rtl or model)
+};
+
+/// What the device and the link are modelled with.
+struct PipelineModel {
+  double clockHz = 100e6;
+  double bandwidthBytesPerSecond = 4e9;
+  double latencySeconds = 1e-6;  // each way: a command reaches the device, a completion the host
+  double bytesPerBox = 24;
+  double bytesPerBeat = 4;
+};
+
+/// An interval of one lane of the timeline, for the plot.
+struct Span {
+  double start = 0, end = 0;
+  std::size_t run = 0;
+};
+
+/// A frame's timeline. The host is two threads: one produces runs (keys,
+/// tree, packing), as measured but without the decoding the serial run did
+/// in between; one decodes each run's results once they have arrived.
+/// A run waits for the device and the link to be free: its boxes stream in
+/// through the load port, as fast as the slower of the link and the port
+/// (one box a cycle), the device computes, result beats return over the
+/// link, and a completion reaches the host after the latency.
+struct FrameTimeline {
+  double frameSeconds = 0;   // the end of the last decode (or of the producer, if later)
+  double producerSeconds = 0;
+  std::vector<Span> produce, link, device, decode;
+};
+
+/// `hostSeconds`: the frame's measured host time (device simulation excluded),
+/// decoding included, as the serial run spent it.
+FrameTimeline modelPipeline(const std::vector<RunRecord>& runs, double hostSeconds, const PipelineModel& model);
+
+}  // namespace bpaccel
