@@ -39,11 +39,36 @@ std::string describe(const btBroadphaseProxy* proxy) {
 }  // namespace
 
 Broadphase::Broadphase(std::unique_ptr<Backend> backend, BroadphaseOptions options, btOverlappingPairCache* pairCache)
-    : backend_(std::move(backend)), options_(options), broadPhase_(*backend_, options.cellSize) {
-  if (!backend_) throw BroadphaseError("bpaccel::Broadphase: no backend given");
+    : Broadphase(std::move(backend), nullptr, options, pairCache) {}
+
+Broadphase::Broadphase(const BroadPhase::BackendFactory& makeBackend, BroadphaseOptions options,
+                       btOverlappingPairCache* pairCache)
+    : Broadphase(nullptr, &makeBackend, options, pairCache) {}
+
+Broadphase::Broadphase(std::unique_ptr<Backend> backend, const BroadPhase::BackendFactory* makeBackend,
+                       BroadphaseOptions options, btOverlappingPairCache* pairCache)
+    : options_(options), backend_(std::move(backend)) {
   if (options_.maxProxies == 0 || options_.maxProxies > 0xFFFFFFFEull)
     throw BroadphaseError(fmt::format("bpaccel::Broadphase: maxProxies must be in 1..{}, got {}", 0xFFFFFFFEull,
                                       options_.maxProxies));
+  if (options_.threads == 0) throw BroadphaseError("bpaccel::Broadphase: threads must be at least 1");
+  if (makeBackend == nullptr) {
+    if (!backend_) throw BroadphaseError("bpaccel::Broadphase: no backend given");
+    if (options_.threads != 1)
+      throw BroadphaseError(fmt::format("bpaccel::Broadphase: {} threads need a backend each: pass a backend factory",
+                                        options_.threads));
+    backendName_ = backend_->name();
+    broadPhase_ = std::make_unique<BroadPhase>(*backend_, options_.cellSize);
+  } else {
+    if (!*makeBackend) throw BroadphaseError("bpaccel::Broadphase: empty backend factory");
+    auto naming = [this, makeBackend]() {
+      std::unique_ptr<Backend> b = (*makeBackend)();
+      if (!b) throw BroadphaseError("bpaccel::Broadphase: the backend factory returned no backend");
+      backendName_ = b->name();
+      return b;
+    };
+    broadPhase_ = std::make_unique<BroadPhase>(naming, options_.cellSize, options_.threads);
+  }
   if (pairCache == nullptr) ownedCache_ = std::make_unique<btHashedOverlappingPairCache>();
   cache_ = pairCache != nullptr ? pairCache : ownedCache_.get();
 }
@@ -172,7 +197,7 @@ void Broadphase::calculateOverlappingPairs(btDispatcher* dispatcher) {
   const auto start = Clock::now();
   report_ = FrameReport{};
   report_.proxies = boxes_.size();
-  broadPhase_.findPairs(std::span<const Aabb>(boxes_), found_);
+  broadPhase_->findPairs(std::span<const Aabb>(boxes_), found_);
   report_.overlaps = found_.size();
   const auto found = Clock::now();
   report_.findSeconds = std::chrono::duration<double>(found - start).count();
@@ -280,11 +305,11 @@ void Broadphase::resetPool(btDispatcher* /*dispatcher*/) {
 }
 
 void Broadphase::printStats() {
-  const RunStats& s = broadPhase_.stats();
+  const RunStats& s = broadPhase_->stats();
   fmt::print("bpaccel::Broadphase: backend {} cell size {}, {} proxies, {} cached pairs\n"
              "  last frame: {} overlaps, {} added, {} refused by the filter, {} removed, find {:.6f} s, cache {:.6f} s\n"
              "  all frames: {} runs, {} device cycles, {} hits\n",
-             backend_->name(), options_.cellSize ? fmt::format("{}", *options_.cellSize) : std::string("none"),
+             backendName_, options_.cellSize ? fmt::format("{}", *options_.cellSize) : std::string("none"),
              boxes_.size(), cache_->getNumOverlappingPairs(), report_.overlaps, report_.added, report_.refused,
              report_.removed, report_.findSeconds, report_.cacheSeconds, s.runs, s.deviceCycles(), s.hits);
 }

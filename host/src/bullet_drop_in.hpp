@@ -32,6 +32,8 @@ struct BroadphaseOptions {
   std::optional<std::size_t> cellSize = 64;
   /// Most live proxies; createProxy beyond it throws. Indices are 32-bit, so never more than 2^32 - 2.
   std::uint64_t maxProxies = 0xFFFFFFFEull;
+  /// Threads sharing the k-d tree's cells; more than one needs a backend factory.
+  std::size_t threads = 1;
 };
 
 /// What the last calculateOverlappingPairs did and spent (steady clock).
@@ -65,6 +67,9 @@ class Broadphase final : public btBroadphaseInterface {
   /// caller's cache, which must outlive this broad phase and hold only its proxies.
   explicit Broadphase(std::unique_ptr<Backend> backend, BroadphaseOptions options = {},
                       btOverlappingPairCache* pairCache = nullptr);
+  /// `options.threads` workers, each with a backend of its own from `makeBackend`.
+  explicit Broadphase(const BroadPhase::BackendFactory& makeBackend, BroadphaseOptions options = {},
+                      btOverlappingPairCache* pairCache = nullptr);
   ~Broadphase() override;
   Broadphase(const Broadphase&) = delete;
   Broadphase& operator=(const Broadphase&) = delete;
@@ -93,9 +98,10 @@ class Broadphase final : public btBroadphaseInterface {
 
   std::size_t proxyCount() const { return boxes_.size(); }
   const FrameReport& lastFrame() const { return report_; }
-  const Backend& backend() const { return *backend_; }
+  /// The backend's name (cpu, model, rtl).
+  const std::string& backendName() const { return backendName_; }
   /// Statistics of the pair finding, summed over all frames.
-  const RunStats& runStats() const { return broadPhase_.stats(); }
+  const RunStats& runStats() const { return broadPhase_->stats(); }
 
  private:
   struct Proxy;
@@ -107,9 +113,13 @@ class Broadphase final : public btBroadphaseInterface {
   void removeDeferred(btDispatcher* dispatcher);
   static Aabb checkedBox(const btVector3& aabbMin, const btVector3& aabbMax, const Proxy* proxy, const char* what);
 
-  std::unique_ptr<Backend> backend_;
+  Broadphase(std::unique_ptr<Backend> backend, const BroadPhase::BackendFactory* makeBackend,
+             BroadphaseOptions options, btOverlappingPairCache* pairCache);
+
   BroadphaseOptions options_;
-  BroadPhase broadPhase_;
+  std::string backendName_;
+  std::unique_ptr<Backend> backend_;         // the one backend, unless a factory makes them
+  std::unique_ptr<BroadPhase> broadPhase_;
   std::unique_ptr<btOverlappingPairCache> ownedCache_;
   btOverlappingPairCache* cache_;
   std::vector<std::unique_ptr<Proxy>> slots_;   // by slot; storage kept after destroyProxy

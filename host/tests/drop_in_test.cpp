@@ -63,6 +63,12 @@ Factory simple() {
 Factory accel(const std::string& backend, std::optional<std::size_t> cellSize) {
   return [=] { return std::make_unique<Broadphase>(makeBackend(backend), bpaccel::BroadphaseOptions{cellSize}); };
 }
+Factory accelThreads(const std::string& backend, std::size_t cellSize, std::size_t threads) {
+  return [=] {
+    return std::make_unique<Broadphase>([=] { return makeBackend(backend); },
+                                        bpaccel::BroadphaseOptions{cellSize, 0xFFFFFFFEull, threads});
+  };
+}
 Factory dropping() {
   return [] { return std::make_unique<Broadphase>(std::make_unique<DroppingBackend>(), bpaccel::BroadphaseOptions{}); };
 }
@@ -301,6 +307,8 @@ TEST(DropIn, TrajectoriesBitIdenticalToSimpleBroadphase) {
   EXPECT_EQ(firstDivergentFrame(bouncing(200), simple(), accel("cpu", std::nullopt), 200), -1);
   EXPECT_EQ(firstDivergentFrame(bouncing(200), simple(), accel("model", 16), 200), -1);
   EXPECT_EQ(firstDivergentFrame(stacked(true), simple(), accel("model", 8), 200), -1);
+  // Threads finish their cells in any order; the cache still changes in one order.
+  EXPECT_EQ(firstDivergentFrame(bouncing(200), simple(), accelThreads("cpu", 8, 3), 100), -1);
 }
 
 TEST(DropIn, TrajectoriesBitIdenticalOnTheVerilatedHardware) {
@@ -508,6 +516,11 @@ TEST(DropIn, RefusesMoreProxiesThanAllowed) {
   bp.destroyProxy(a, &fx.dispatcher);
   EXPECT_NO_THROW(box(bp, fx, 0, 1));
   EXPECT_THROW(Broadphase(makeBackend("cpu"), {64, 0}), BroadphaseError);
+  // Threads need a backend each.
+  EXPECT_THROW(Broadphase(makeBackend("cpu"), {64, 100, 2}), BroadphaseError);
+  EXPECT_THROW(Broadphase(makeBackend("cpu"), {64, 100, 0}), BroadphaseError);
+  EXPECT_THROW(Broadphase([] { return std::unique_ptr<bpaccel::Backend>(); }, {64, 100, 2}), BroadphaseError);
+  EXPECT_EQ(Broadphase([] { return makeBackend("model"); }, {64, 100, 2}).backendName(), "model");
 }
 
 TEST(DropIn, RejectsForeignAndDestroyedProxies) {

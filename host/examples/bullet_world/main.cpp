@@ -53,7 +53,7 @@ int main() {
     }
   }
   std::printf("bullet_world: %zu boxes, %d pairs cached, backend %s: %s\n", boxes.size(),
-              broadphase.getOverlappingPairCache()->getNumOverlappingPairs(), broadphase.backend().name().c_str(),
+              broadphase.getOverlappingPairCache()->getNumOverlappingPairs(), broadphase.backendName().c_str(),
               failures == 0 ? "all at rest" : "FAILED");
   for (const auto& box : boxes) world.removeRigidBody(box.get());
   world.removeRigidBody(&floor);
