@@ -312,7 +312,7 @@ TEST(DropIn, TrajectoriesBitIdenticalToSimpleBroadphase) {
 }
 
 TEST(DropIn, TrajectoriesBitIdenticalOnTheVerilatedHardware) {
-  EXPECT_EQ(firstDivergentFrame(bouncing(150), simple(), accel("rtl", 64), 20), -1);
+  EXPECT_EQ(firstDivergentFrame(bouncing(150), simple(), accel("rtl", 64), 60), -1);
 }
 
 TEST(DropIn, ComparisonWithDbvtTrajectoriesIsOnlyAboutContacts) {
