@@ -12,7 +12,8 @@ lazy val root = (project in file("."))
     libraryDependencies ++= Seq(
       "org.chipsalliance" %% "chisel"     % chiselVersion,
       "com.github.scopt"  %% "scopt"      % "4.1.0",
-      "edu.berkeley.cs"   %% "chiseltest" % "6.0.0" % Test
+      "edu.berkeley.cs"   %% "chiseltest" % "6.0.0" % Test,
+      "org.scalatestplus" %% "scalacheck-1-17" % "3.2.17.0" % Test
     ),
     addCompilerPlugin("org.chipsalliance" % "chisel-plugin" % chiselVersion cross CrossVersion.full),
     scalacOptions ++= Seq(
