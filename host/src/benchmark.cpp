@@ -246,6 +246,14 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
     }
   }
 
+  nlohmann::json teardown = nlohmann::json::object();
+  for (Entry& e : entries)
+    if (e.method) {
+      const auto t0 = Clock::now();
+      e.method.reset();
+      teardown[e.spec->name] = since(t0);
+    }
+
   nlohmann::json row;
   row["objects"] = objects;
   row["cube_edge"] = scene.cubeEdge();
@@ -257,7 +265,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
   const Entry* fastest = nullptr;
   std::map<std::string, const Entry*> fastestOf;
   for (const Entry& e : entries) {
-    if (!e.method || !isBaseline(e.spec->kind)) continue;
+    if (e.skipped || !isBaseline(e.spec->kind)) continue;
     const double t = median(e.frameSeconds);
     const Entry*& lib = fastestOf[e.spec->library];
     if (!lib || t < median(lib->frameSeconds)) lib = &e;
@@ -307,7 +315,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
     const double mine = median(e.frameSeconds);
     nlohmann::json acc = nlohmann::json::object();
     for (const Entry& b : entries)
-      if (b.method && isBaseline(b.spec->kind)) acc[b.spec->name] = median(b.frameSeconds) / mine;
+      if (!b.skipped && isBaseline(b.spec->kind)) acc[b.spec->name] = median(b.frameSeconds) / mine;
     j["acceleration_over"] = acc;
     j["acceleration_over_fastest_baseline"] = fastest ? nlohmann::json(median(fastest->frameSeconds) / mine) : nullptr;
     methods.push_back(j);
@@ -316,13 +324,14 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
 
   nlohmann::json setup = nlohmann::json::object(), update = nlohmann::json::object();
   for (const Entry& e : entries)
-    if (e.method) {
+    if (!e.skipped) {
       setup[e.spec->name] = e.setupSeconds;
       update[e.spec->name] = e.updateSeconds;
     }
   row["time_s"] = {{"scene_setup", sceneSetup},       {"physics_steps", physicsSeconds},
                    {"exact_reference", exactSeconds}, {"validation", validationSeconds},
-                   {"method_setup", setup},           {"method_updates", update}};
+                   {"method_setup", setup},           {"method_updates", update},
+                   {"method_teardown", teardown}};
   return row;
 }
 
@@ -444,17 +453,27 @@ std::string Benchmark::table(const nlohmann::json& results) {
         t += fmt::format("\n  n={} {}: skipped: {}", r["objects"].get<std::size_t>(), m["name"].get<std::string>(),
                          m["skipped"].get<std::string>());
       }
-  t += "\nWhere the time went, s (scene set-up, physics steps, exact reference, validation; set-up and timed "
-       "updates summed over methods):";
+  t += "\nWhere the time went, s of wall time (scene set-up, physics steps, exact reference, validation; set-up, "
+       "timed updates and teardown summed over methods):";
   for (const auto& r : rows) {
     const auto& ts = r["time_s"];
-    double setup = 0, updates = 0;
-    for (const auto& [k, v] : ts["method_setup"].items()) setup += v.get<double>();
-    for (const auto& [k, v] : ts["method_updates"].items()) updates += v.get<double>();
+    const auto sum = [](const nlohmann::json& parts) {
+      double s = 0;
+      for (const auto& [k, v] : parts.items()) s += v.get<double>();
+      return s;
+    };
+    std::string slowest;  // the method whose set-up took longest
+    double slowestSetup = -1;
+    for (const auto& [k, v] : ts["method_setup"].items())
+      if (v.get<double>() > slowestSetup) {
+        slowestSetup = v.get<double>();
+        slowest = k;
+      }
     t += fmt::format("\n  n={}: scene {:.2f}, physics {:.2f}, reference {:.2f}, validation {:.2f}, method set-up "
-                     "{:.2f}, method updates {:.2f}",
+                     "{:.2f} (longest: {} {:.2f}), method updates {:.2f}, teardown {:.2f}",
                      r["objects"].get<std::size_t>(), ts["scene_setup"].get<double>(), ts["physics_steps"].get<double>(),
-                     ts["exact_reference"].get<double>(), ts["validation"].get<double>(), setup, updates);
+                     ts["exact_reference"].get<double>(), ts["validation"].get<double>(), sum(ts["method_setup"]),
+                     slowest, slowestSetup, sum(ts["method_updates"]), sum(ts["method_teardown"]));
   }
   t += "\n";
   return t;

@@ -65,9 +65,11 @@ BulletBroadphase::BulletBroadphase(Kind kind, std::span<const Aabb> initial, flo
   broadphase_->calculateOverlappingPairs(dispatcher_.get());
 }
 
-BulletBroadphase::~BulletBroadphase() {
-  for (btBroadphaseProxy* p : proxies_) broadphase_->destroyProxy(p, dispatcher_.get());
-}
+// The broad phase frees its proxies and pair cache itself. Destroying the
+// proxies one by one first would cost the sweep O(n^2) (each removal moves
+// its edges to the end of every axis), and no pair holds a collision
+// algorithm to free: nothing was dispatched.
+BulletBroadphase::~BulletBroadphase() = default;
 
 void BulletBroadphase::update(std::span<const Aabb> boxes) {
   if (boxes.size() != proxies_.size()) throw std::invalid_argument("bullet broadphase: object count changed");

@@ -1,8 +1,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <random>
 #include <set>
+#include <sys/wait.h>
 
 #include "backend.hpp"
 #include "benchmark.hpp"
@@ -328,4 +333,39 @@ TEST(AcceleratorMethod, DeviceTimeCountsLoadCycles) {
   EXPECT_DOUBLE_EQ(t.parts->deviceSeconds,
                    static_cast<double>(t.parts->stats.loadCycles + t.parts->stats.cycles) / 100e6);
   EXPECT_GT(t.parts->stats.cycles, 0u);
+}
+
+namespace {
+
+// Runs the real bpaccel binary; returns its exit code and standard output.
+std::pair<int, std::string> runBenchCli(const std::string& args) {
+  const std::string cmd = std::string(BPACCEL_CLI) + " bench " + args + " 2>/dev/null";
+  std::string out;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  std::size_t got;
+  while ((got = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) out.append(buf.data(), got);
+  return {WEXITSTATUS(::pclose(pipe)), out};
+}
+
+}  // namespace
+
+TEST(BenchCli, NamesTheLinkUnitAndListsSkippedMethodsInTableAndJson) {
+  const auto [helpCode, help] = runBenchCli("--help");
+  EXPECT_EQ(helpCode, 0);
+  EXPECT_NE(help.find("--link-gbytes-per-s"), std::string::npos);
+  EXPECT_NE(help.find("gigabytes per second"), std::string::npos);
+
+  const auto json = std::filesystem::temp_directory_path() / ("bpaccel-bench-" + std::to_string(::getpid()) + ".json");
+  const auto [code, table] = runBenchCli("--objects 40 --frames 1 --warmup 0 --backend model --cell-sizes none 8 "
+                                         "--max-all-pairs-tests 100 --json " + json.string());
+  EXPECT_EQ(code, 0) << table;
+  EXPECT_NE(table.find("n=40 btSimpleBroadphase: skipped: tests all pairs"), std::string::npos) << table;
+  EXPECT_NE(table.find("n=40 cpu k-d none: skipped"), std::string::npos) << table;
+  std::ifstream in(json);
+  const auto j = nlohmann::json::parse(in);
+  std::size_t skipped = 0;
+  for (const auto& m : j["rows"][0]["methods"]) skipped += m.contains("skipped");
+  EXPECT_EQ(skipped, 3u);  // btSimpleBroadphase, accelerator and cpu without the tree
+  std::filesystem::remove(json);
 }
