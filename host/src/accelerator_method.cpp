@@ -23,6 +23,9 @@ FrameTime AcceleratorMethod::frameTime(double measuredSeconds) const {
   p.hostSeconds = measuredSeconds - phase_.times().backendSeconds;  // simulating the device is not host work
   p.deviceSeconds = static_cast<double>(p.stats.deviceCycles()) / device_->clockHz;
   p.transferSeconds = device_->link.seconds(p.stats, device_->beatBytes, device_->clockHz);
+  const PipelineModel model{device_->clockHz, device_->link.bandwidthBytesPerSecond, device_->link.latencySecondsPerRun,
+                            LinkModel::kBytesPerBox, static_cast<double>(device_->beatBytes)};
+  p.pipeline = std::make_shared<const FrameTimeline>(modelPipeline(phase_.runs(), p.hostSeconds, model));
   return {p.hostSeconds + p.deviceSeconds + p.transferSeconds, p};
 }
 

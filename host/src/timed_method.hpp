@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "timeline.hpp"
 #include "types.hpp"
 
 namespace bpaccel {
@@ -31,6 +32,9 @@ struct ModelledParts {
   double deviceSeconds = 0;    // modelled: device cycles / clock
   double transferSeconds = 0;  // modelled: link model
   RunStats stats;              // the device's counters for the frame
+  /// Modelled schedule of the same measured work with host, link and device
+  /// overlapped (modelPipeline); the serial sum above is what the host runs today.
+  std::shared_ptr<const FrameTimeline> pipeline;
 };
 
 /// What the table reports for one frame of a method.

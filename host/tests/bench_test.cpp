@@ -178,15 +178,29 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
       EXPECT_EQ(m["acceleration_over"].size(), 9u);
       if (m["kind"] == "accelerator")
         for (const char* part : {"host_ms_measured", "device_ms_modelled", "transfer_ms_modelled", "device_cycles",
-                                 "load_cycles", "runs"})
+                                 "load_cycles", "runs", "serial_frame_ms", "pipelined_frame_ms_modelled"})
           EXPECT_TRUE(m.contains(part)) << part;
+      if (m["kind"] == "accelerator") {
+        // Overlapping can hide host and link time, never the device's own busy cycles.
+        EXPECT_GE(m["pipelined_frame_ms_modelled"]["median"].get<double>() * (1 + 1e-9),
+                  m["device_ms_modelled"]["min"].get<double>())
+            << m["name"];
+        EXPECT_EQ(m["serial_frame_ms"], m["frame_ms"]) << m["name"];
+      }
     }
+    // The timeline of the row's best accelerator method: one device span per run.
+    const auto& tl = row["timeline"];
+    ASSERT_TRUE(tl.is_object());
+    EXPECT_EQ(tl["lanes"]["device"].size(), tl["runs"].get<std::size_t>());
+    EXPECT_GT(tl["frame_ms"].get<double>(), 0);
+    for (const char* lane : {"produce", "link", "device", "decode"}) EXPECT_TRUE(tl["lanes"].contains(lane)) << lane;
   }
   EXPECT_EQ(kinds, (std::set<std::string>{"bullet", "peer", "accelerator", "cpu"}));
   EXPECT_EQ(libraries, (std::set<std::string>{"Bullet 3.24", "FCL 0.7", "CGAL 5.5", "ODE 0.16", "bpaccel"}));
   const std::string table = Benchmark::table(j);
   for (const char* s : {"btDbvtBroadphase", "FCL DynamicAABBTree", "CGAL box_self_intersection_d", "ODE dHashSpace",
-                        "accelerator k-d 16", "Acceleration over the FASTEST", "Acceleration over the fastest of FCL 0.7"})
+                        "accelerator k-d 16", "Acceleration over the FASTEST", "Acceleration over the fastest of FCL 0.7",
+                        "MODELLED schedule"})
     EXPECT_NE(table.find(s), std::string::npos) << s;
 }
 
