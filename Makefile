@@ -4,15 +4,24 @@
 SHELL := /bin/bash
 SBT   := ./scripts/sbt
 
-# Configuration of `make verilog` (see README): parallelism, objects per run, key width.
+# Configuration of `make verilog` (see README): architecture (seed: the
+# published design; stream: one memory read a cycle, see
+# docs/microarchitecture.md), parallelism, objects per run, key width.
+ARCH      ?= seed
 M         ?= 8
+ifeq ($(ARCH),stream)
+CAPACITY  ?= 2048
+else
 CAPACITY  ?= $(shell echo $$((256 * $(M))))
+endif
 KEY_WIDTH ?= 32
-VERILOG_DIR ?= generated/m$(M)
+# Folders and reports of the seed architecture keep their names; others get the architecture as prefix.
+ARCH_PREFIX := $(if $(filter seed,$(ARCH)),,$(ARCH)-)
+VERILOG_DIR ?= generated/$(ARCH_PREFIX)m$(M)
 
-# The host is built for one configuration: M and CAPACITY above.
-HOST_VERILOG := build/verilog/m$(M)-c$(CAPACITY)
-HOST_BUILD   := build/host-m$(M)-c$(CAPACITY)
+# The host is built for one configuration: ARCH, M and CAPACITY above.
+HOST_VERILOG := build/verilog/$(ARCH_PREFIX)m$(M)-c$(CAPACITY)
+HOST_BUILD   := build/host-$(ARCH_PREFIX)m$(M)-c$(CAPACITY)
 SCALA_SOURCES := $(wildcard src/bpaccel/*.scala) build.sbt
 
 # Debian's interpreter, which has python3-matplotlib.
@@ -41,7 +50,7 @@ test-hw: deps
 
 # The C++ host (build/bin/bpaccel) with the Verilated accelerator, and its tests.
 $(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
-	$(SBT) "runMain bpaccel.EmitVerilog --m $(M) --capacity $(CAPACITY) --key-width 32 --target-dir $(HOST_VERILOG)"
+	$(SBT) "runMain bpaccel.EmitVerilog --arch $(ARCH) --m $(M) --capacity $(CAPACITY) --key-width 32 --target-dir $(HOST_VERILOG)"
 
 host: deps $(HOST_VERILOG)/filelist.f
 	cmake -S host -B $(HOST_BUILD) -G Ninja -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG))
@@ -95,23 +104,25 @@ fuzz-long: fuzz
 
 # Fmax, and a Xilinx 7-series synthesis estimate.
 fpga: deps
-	$(MAKE) verilog M=$(M) CAPACITY=$(CAPACITY) KEY_WIDTH=$(KEY_WIDTH) VERILOG_DIR=build/fpga-verilog/m$(M)
-	$(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/m$(M) --m $(M) --out results/fpga/m$(M).json
+	$(MAKE) verilog ARCH=$(ARCH) M=$(M) CAPACITY=$(CAPACITY) KEY_WIDTH=$(KEY_WIDTH) VERILOG_DIR=build/fpga-verilog/$(ARCH_PREFIX)m$(M)
+	$(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/$(ARCH_PREFIX)m$(M) --m $(M) --out results/fpga/$(ARCH_PREFIX)m$(M).json $(FPGA_ARGS)
 
 fpga-sweep: deps
-	$(PYTHON) scripts/fpga/sweep.py --verilog-root build/fpga-verilog --emit always --budget-min 60
+	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --verilog-root build/fpga-verilog --emit always --budget-min 60
 
 $(FPGA_TEST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
 	$(SBT) "runMain bpaccel.EmitVerilog --m 2 --target-dir $(FPGA_TEST_VERILOG)"
+# Options for flow.py, e.g. FPGA_ARGS="--router router2 --threads 2".
+FPGA_ARGS ?=
 
 test-fpga: deps $(FPGA_TEST_VERILOG)/filelist.f
 	$(PYTHON) scripts/fpga/test_flow.py $(FPGA_TEST_VERILOG)
 
 # SystemVerilog (one file per module, filelist.f) and bpaccel_params.h for one configuration.
 verilog: deps
-	$(SBT) "runMain bpaccel.EmitVerilog --m $(M) --capacity $(CAPACITY) --key-width $(KEY_WIDTH) --target-dir $(VERILOG_DIR)"
-	cd $(VERILOG_DIR) && verilator --lint-only -Wall -F filelist.f --top-module BroadPhaseAccel
-	@echo "Verilog for m=$(M), capacity=$(CAPACITY): $(VERILOG_DIR)/filelist.f"
+	$(SBT) "runMain bpaccel.EmitVerilog --arch $(ARCH) --m $(M) --capacity $(CAPACITY) --key-width $(KEY_WIDTH) --target-dir $(VERILOG_DIR)"
+	cd $(VERILOG_DIR) && verilator --lint-only -Wall lint_waivers.vlt -F filelist.f --top-module BroadPhaseAccel
+	@echo "Verilog for arch=$(ARCH), m=$(M), capacity=$(CAPACITY): $(VERILOG_DIR)/filelist.f"
 
 clean:
 	rm -rf target project/target generated build test_run_dir

@@ -12,9 +12,11 @@ std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m) {
   return blocks * (n - 1) - m * blocks * (blocks - 1) / 2;
 }
 
-ModelBackend::ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles)
-    : m_(m), capacity_(capacity), overhead_(runOverheadCycles) {
-  if (m == 0 || capacity < 2 || capacity % m != 0)
+ModelBackend::ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles,
+                           std::uint64_t streamReadLatency)
+    : m_(m), capacity_(capacity), overhead_(runOverheadCycles), streamReadLatency_(streamReadLatency) {
+  // Only the seed architecture stripes objects over m memories.
+  if (m == 0 || capacity < 2 || (streamReadLatency == 0 && capacity % m != 0))
     throw std::invalid_argument(fmt::format("model: invalid m = {} / capacity = {}", m, capacity));
 }
 
@@ -39,10 +41,14 @@ void ModelBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, Ru
     }
   }
   const std::uint64_t issue = scheduleIssueCycles(n, m_);
+  // Stream: the window must hold objects 1..m (n <= m: m+1-n shifts after the
+  // load) while the first reads reach its entry.
+  const std::uint64_t startup =
+      n < 2 || streamReadLatency_ == 0 ? 0 : std::max<std::uint64_t>(m_ + 1 > n ? m_ + 1 - n : 0, streamReadLatency_);
   stats.runs += 1;
   stats.loadCycles += n + 1;  // one box a cycle, then the start cycle
   stats.issueCycles += issue;
-  stats.cycles += n < 2 ? 0 : issue + overhead_;
+  stats.cycles += n < 2 ? 0 : startup + issue + overhead_;
   stats.hits += out.size() - before;
   stats.boxesSent += n;
   stats.beatsReceived += beats;

@@ -34,10 +34,14 @@ std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m);
 /// Fast C++ model of the accelerator: the same schedule, pairs and cycle
 /// counts (loads included) as the RTL driven by a host that loads one box a
 /// cycle and a consumer that never stalls, for any n up to its capacity and
-/// at software speed.
+/// at software speed. Both architectures share the schedule and differ only
+/// in the cycles before the first issue: none for the seed's; for the
+/// stream's, max(m + 1 - n, streamReadLatency) (BPACCEL_READ_LATENCY, 0 for
+/// the seed's, so passing the header's values always models the hardware built).
 class ModelBackend final : public Backend {
  public:
-  ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles);
+  ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles,
+               std::uint64_t streamReadLatency = 0);
   std::string name() const override { return "model"; }
   std::size_t capacity() const override { return capacity_; }
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
@@ -46,6 +50,7 @@ class ModelBackend final : public Backend {
   std::size_t m_;
   std::size_t capacity_;
   std::uint64_t overhead_;
+  std::uint64_t streamReadLatency_;  // 0: the seed architecture
 };
 
 /// Software alone: all pairs of the batch with SIMD compares (AllPairsKernel),

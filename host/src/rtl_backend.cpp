@@ -46,10 +46,12 @@ RtlBackend::RtlBackend(std::function<bool(std::uint64_t)> consumerReady)
           fmt::format("rtl: Verilated model has {} = {} but bpaccel_params.h says {}; rebuild the host", what, model,
                       header));
   };
+  check("architecture", top_->io_info_arch, BPACCEL_ARCH_ID);
   check("m", top_->io_info_m, BPACCEL_M);
   check("capacity", top_->io_info_capacity, BPACCEL_CAPACITY);
   check("key width", top_->io_info_keyWidth, BPACCEL_KEY_WIDTH);
   check("run overhead cycles", top_->io_info_runOverheadCycles, BPACCEL_RUN_OVERHEAD_CYCLES);
+  check("read latency", top_->io_info_readLatency, BPACCEL_READ_LATENCY);
 }
 
 RtlBackend::~RtlBackend() { top_->final(); }
@@ -57,6 +59,11 @@ RtlBackend::~RtlBackend() { top_->final(); }
 std::size_t RtlBackend::capacity() const { return BPACCEL_CAPACITY; }
 std::size_t RtlBackend::lanes() { return BPACCEL_M; }
 std::uint64_t RtlBackend::runOverheadCycles() { return BPACCEL_RUN_OVERHEAD_CYCLES; }
+std::string RtlBackend::architecture() { return BPACCEL_ARCH; }
+
+ModelBackend modelOfBuiltHardware() {
+  return ModelBackend(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES, BPACCEL_READ_LATENCY);
+}
 
 void RtlBackend::settle() {
   top_->clock = 0;

@@ -32,6 +32,8 @@ class RtlBackend final : public Backend {
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
 
   static std::size_t lanes();
+  /// "seed" or "stream": the architecture this host was built with.
+  static std::string architecture();
   static std::uint64_t runOverheadCycles();
 
  private:
@@ -44,5 +46,8 @@ class RtlBackend final : public Backend {
   std::unique_ptr<VBroadPhaseAccel> top_;
   std::function<bool(std::uint64_t)> consumerReady_;
 };
+
+/// The C++ model of exactly the hardware this host was built with.
+ModelBackend modelOfBuiltHardware();
 
 }  // namespace bpaccel

@@ -35,6 +35,15 @@ BothRuns runBoth(Backend& rtl, Backend& model, const std::vector<Aabb>& boxes) {
   return r;
 }
 
+// Cycles from the start to done of a run of n boxes with a consumer that never
+// stalls, from the header's closed form (independent of ModelBackend).
+std::uint64_t expectedRunCycles(std::uint64_t n) {
+  if (n < 2) return 0;
+  const std::uint64_t startup =
+      BPACCEL_ARCH_STREAM ? std::max<std::uint64_t>(BPACCEL_M + 1 > n ? BPACCEL_M + 1 - n : 0, BPACCEL_READ_LATENCY) : 0;
+  return startup + scheduleIssueCycles(n, BPACCEL_M) + BPACCEL_RUN_OVERHEAD_CYCLES;
+}
+
 // One run of the hardware against the model and the brute-force reference.
 void expectSameRun(const std::string& label, const std::vector<Aabb>& boxes, const BothRuns& r) {
   const auto& [fromRtl, fromModel, rtlStats, modelStats] = r;
@@ -46,15 +55,20 @@ void expectSameRun(const std::string& label, const std::vector<Aabb>& boxes, con
   EXPECT_EQ(rtlStats.cycles, modelStats.cycles) << label;
   EXPECT_EQ(rtlStats.beatsReceived, modelStats.beatsReceived) << label;
   EXPECT_EQ(rtlStats.issueCycles, scheduleIssueCycles(n, BPACCEL_M)) << label;
-  EXPECT_EQ(rtlStats.cycles, n < 2 ? 0 : scheduleIssueCycles(n, BPACCEL_M) + BPACCEL_RUN_OVERHEAD_CYCLES) << label;
+  EXPECT_EQ(rtlStats.cycles, expectedRunCycles(n)) << label;
   EXPECT_EQ(rtlStats.stallCycles, 0u) << label;
 }
 
 }  // namespace
 
+TEST(RtlBackend, ReportsTheArchitectureItWasBuiltWith) {
+  EXPECT_EQ(RtlBackend::architecture(), BPACCEL_ARCH_STREAM ? "stream" : "seed");
+  EXPECT_NO_THROW(RtlBackend{});  // the constructor checks the info port against the header
+}
+
 TEST(RtlBackend, AgreesWithTheModelOnPairsCyclesAndBeats) {
   RtlBackend rtl;
-  ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+  ModelBackend model = modelOfBuiltHardware();
   std::mt19937 rng(42);
   std::vector<std::size_t> sizes = {0, 1, 2, 3, BPACCEL_M - 1, BPACCEL_M, BPACCEL_M + 1, 2 * BPACCEL_M + 1,
                                     BPACCEL_CAPACITY};
@@ -69,7 +83,7 @@ TEST(RtlBackend, AgreesWithTheModelOnPairsCyclesAndBeats) {
 TEST(RtlBackend, TheComparisonCatchesAWrongPairAndAWrongCount) {
   // The same comparison as above must fail when one pair or one count is off.
   RtlBackend rtl;
-  ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+  ModelBackend model = modelOfBuiltHardware();
   const auto boxes = adversarialScenes(40, 3).at(1).second;  // clusters: many hits
   const BothRuns runs = runBoth(rtl, model, boxes);
   ASSERT_FALSE(runs.fromRtl.empty());
@@ -95,13 +109,13 @@ TEST(RtlBackend, TheComparisonCatchesAWrongPairAndAWrongCount) {
 TEST(RtlBackend, StallingConsumerLosesNoPairAndCountsTheStalls) {
   std::mt19937 pattern(5);
   RtlBackend rtl([&](std::uint64_t) { return pattern() % 4 == 0; });
-  ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+  ModelBackend model = modelOfBuiltHardware();
   std::uint64_t stalls = 0;
   for (const auto& [name, boxes] : adversarialScenes(300, 77)) {
     const auto [fromRtl, fromModel, rtlStats, modelStats] = runBoth(rtl, model, boxes);
     EXPECT_EQ(fromRtl, fromModel) << name;
     stalls += rtlStats.stallCycles;
-    EXPECT_EQ(rtlStats.cycles, rtlStats.issueCycles + rtlStats.stallCycles + BPACCEL_RUN_OVERHEAD_CYCLES) << name;
+    EXPECT_EQ(rtlStats.cycles, rtlStats.stallCycles + expectedRunCycles(300)) << name;
     EXPECT_EQ(rtlStats.issueCycles, scheduleIssueCycles(300, BPACCEL_M)) << name;
     EXPECT_EQ(rtlStats.loadCycles, modelStats.loadCycles) << name;
   }
@@ -111,7 +125,7 @@ TEST(RtlBackend, StallingConsumerLosesNoPairAndCountsTheStalls) {
 TEST(RtlBackend, RecoversAfterAHungRunAndRunsTheNextBatchExactly) {
   bool consumerStuck = true;  // a consumer that never takes a beat hangs the run
   RtlBackend rtl([&](std::uint64_t) { return !consumerStuck; });
-  ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+  ModelBackend model = modelOfBuiltHardware();
   const auto dense = adversarialScenes(60, 9).at(1).second;  // clusters: a hit the consumer never takes
   std::vector<Pair> pairs;
   RunStats stats;

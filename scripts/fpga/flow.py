@@ -278,13 +278,13 @@ def stat_cells(path: Path) -> tuple[dict[str, int], dict[str, dict[str, int]]]:
     return total, mods
 
 
-def memory_mapping(text: str) -> dict[str, int]:
-    """How memory_libmap mapped each memory: {mapping cell: count}; memories left to
-    memory_map (flip-flops and muxes) are counted under "FF"."""
+def memory_mapping(text: str, name_re: str = r"\S+") -> dict[str, int]:
+    """How memory_libmap mapped each memory whose name matches name_re: {mapping cell:
+    count}; memories left to memory_map (flip-flops and muxes) are counted under "FF"."""
     out: dict[str, int] = {}
-    for cell in re.findall(r"^mapping memory \S+ via (\S+)", text, re.M):
+    for cell in re.findall(rf"^mapping memory {name_re} via (\S+)", text, re.M):
         out[cell] = out.get(cell, 0) + 1
-    ff = len(re.findall(r"^Mapping memory \S+ in module", text, re.M))
+    ff = len(re.findall(rf"^Mapping memory {name_re} in module", text, re.M))
     if ff:
         out["FF"] = ff
     return out
@@ -338,6 +338,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=1, help="nextpnr placer seed")
     ap.add_argument("--router", choices=["router1", "router2"], default="router1",
                     help="nextpnr router (router2 is faster on congested designs, router1 gave higher Fmax at m = 8)")
+    ap.add_argument("--threads", type=int, default=1,
+                    help="nextpnr threads (placer and router2 use them; the machine's other jobs share the cores)")
+    ap.add_argument("--placer", choices=["heap", "sa", "static"], default=None,
+                    help="nextpnr placer (default: nextpnr's own, heap on ECP5)")
     ap.add_argument("--timeout", type=float, default=None, help="seconds for the whole run (exit 4 past it)")
     ap.add_argument("--no-xilinx", action="store_true", help="skip the Xilinx estimate")
     ap.add_argument("--no-breakdown", action="store_true", help="skip the per-module ECP5 synthesis")
@@ -406,13 +410,17 @@ def flow(args) -> int:
     if code != 0 or not (work / "ecp5.json").exists():
         raise FlowError(EXIT_TOOL, "ECP5 synthesis failed")
     ecp5_cells, _ = stat_cells(work / "ecp5_stat.json")
-    ecp5_memmap = memory_mapping(ytext)
+    # The coordinate memories (mem_*); the result queue's small memory may go to LUT RAM.
+    ecp5_memmap = memory_mapping(ytext, COORD_MEMORY_RE)
+    ecp5_memmap_all = memory_mapping(ytext)
 
     # ---- the wrapper's own cost
     wrapper_cells = wrapper_only_cells(runner, yosys, work)
 
     # ---- did the memories become block RAM?
-    n_mems = 6 * m
+    # seed: 6m striped memories; stream: one memory of six keys a row.
+    arch = params.get("arch", "seed")
+    n_mems = 1 if arch == "stream" else 6 * m
     dp16 = ecp5_cells.get("DP16KD", 0)
     bram_mapped = sum(v for k, v in ecp5_memmap.items() if "16KD" in k)
     mems_in_bram = bram_mapped == n_mems and dp16 >= n_mems and "FF" not in ecp5_memmap \
@@ -422,9 +430,11 @@ def flow(args) -> int:
         "instances": n_mems,
         "module": mem_modules,
         "ecp5_mapping": ecp5_memmap,
+        "ecp5_mapping_all_memories": ecp5_memmap_all,
         "dp16kd_per_memory": per_mem,
         "memories_in_bram": mems_in_bram,
-        "note": ("each memory has one read/write and one read port; Yosys maps it to two "
+        "note": (f"one memory of six keys a row, {dp16} DP16KD" if arch == "stream" and mems_in_bram else
+                 "each memory has one read/write and one read port; Yosys maps it to two "
                  "pseudo-dual-port DP16KD (1 write + 1 read port, 512x36), written together, one per "
                  "read port: 2 DP16KD per memory, each using 256 of its 512 rows"
                  if mems_in_bram and per_mem == 2 else
@@ -440,7 +450,9 @@ def flow(args) -> int:
                "--lpf-allow-unconstrained", "--freq", f"{args.clock_mhz:g}", "--timing-allow-fail",
                "--seed", str(args.seed), "--router", args.router, "--report", "nextpnr_report.json"]
     if "--threads" in npr_help:
-        npr_cmd += ["--threads", "1"]
+        npr_cmd += ["--threads", str(args.threads)]
+    if args.placer:
+        npr_cmd += ["--placer", args.placer]
     code, ntext = runner.run("nextpnr-ecp5", npr_cmd, "nextpnr.log")
     util = nextpnr_utilisation(ntext)
     over = {k: v for k, v in util.items() if v["used"] > v["available"]}
@@ -452,7 +464,7 @@ def flow(args) -> int:
             log("the design does NOT fit the device: " +
                 (", ".join(f"{k} {v['used']}/{v['available']}" for k, v in over.items()) or nofit_msg.group(0)))
             if not args.no_xilinx:
-                xil = xilinx(runner, args.debian_yosys, src_list, m)
+                xil = xilinx(runner, args.debian_yosys, src_list, n_mems)
             breakdown = None
             if not args.no_breakdown:
                 breakdown = ecp5_breakdown(runner, yosys, src_list, mods, mem_modules,
@@ -488,7 +500,7 @@ def flow(args) -> int:
             raise FlowError(EXIT_TOOL, "nextpnr log does not show a completed route")
 
     if not args.no_xilinx:
-        xil = xilinx(runner, args.debian_yosys, src_list, m)
+        xil = xilinx(runner, args.debian_yosys, src_list, n_mems)
 
     breakdown = None
     if not args.no_breakdown:
@@ -624,7 +636,7 @@ def blackbox_stub(ports) -> str:
 
 
 def parse_params(vdir: Path) -> dict:
-    """m / capacity / key width from bpaccel_params.h when present."""
+    """arch / m / capacity / key width from bpaccel_params.h when present."""
     h = vdir / "bpaccel_params.h"
     out = {}
     if h.is_file():
@@ -634,6 +646,8 @@ def parse_params(vdir: Path) -> dict:
             mm = re.search(rf"^#define\s+{macro}\s+(\d+)", text, re.M)
             if mm:
                 out[key] = int(mm.group(1))
+        mm = re.search(r'^#define\s+BPACCEL_ARCH\s+"(\w+)"', text, re.M)
+        out["arch"] = mm.group(1) if mm else "seed"  # headers from before the stream architecture
     return out
 
 
@@ -642,6 +656,7 @@ def base_report(m, capacity, params, args, versions, wrapper_info) -> dict:
         raise FlowError(EXIT_INPUT, f"--m {m} but {args.verilog_dir}/bpaccel_params.h says m = {params['m']}")
     return {
         "schema": "bpaccel-fpga-1",
+        "arch": params.get("arch", "seed"),
         "m": m,
         "capacity": capacity,
         "key_width": params.get("key_width"),
@@ -653,12 +668,14 @@ def base_report(m, capacity, params, args, versions, wrapper_info) -> dict:
         "clock_constraint_mhz": args.clock_mhz,
         "nextpnr_seed": args.seed,
         "nextpnr_router": getattr(args, "router", "router1"),
+        "nextpnr_threads": getattr(args, "threads", 1),
+        "nextpnr_placer": getattr(args, "placer", None) or "default",
         "tool_versions": versions,
         "wrapper": wrapper_info,
     }
 
 
-def xilinx(runner: Runner, debian_yosys: str, src_list: str, m: int) -> dict:
+def xilinx(runner: Runner, debian_yosys: str, src_list: str, n_mems: int) -> dict:
     if not Path(debian_yosys).exists():
         raise FlowError(EXIT_TOOL, f"{debian_yosys} not found (apt-get install yosys)")
     # -flatten: the memory module has separate clock ports for its two ports; only after
@@ -674,7 +691,7 @@ def xilinx(runner: Runner, debian_yosys: str, src_list: str, m: int) -> dict:
         raise FlowError(EXIT_TOOL, "Xilinx synthesis failed")
     cells, _ = stat_cells(runner.work / "xilinx_stat.json")
     lutram = {k: v for k, v in cells.items() if XILINX_LUTRAM_RE.match(k)}
-    memmap = memory_mapping(text)
+    memmap = memory_mapping(text, COORD_MEMORY_RE)
     return {
         "what": "estimate: Yosys synth_xilinx post-synthesis cell counts; no placement, no timing",
         "yosys_version": tool_version([debian_yosys, "-V"], runner.work),
@@ -688,12 +705,14 @@ def xilinx(runner: Runner, debian_yosys: str, src_list: str, m: int) -> dict:
         "carry4": cells.get("CARRY4", 0),
         "dsp48e1": cells.get("DSP48E1", 0),
         "memory_mapping": memmap,
-        "memories_in_bram": sum(v for k, v in memmap.items() if "BLOCKRAM" in k) == 6 * m,
+        "memories_in_bram": sum(v for k, v in memmap.items() if "BLOCKRAM" in k) == n_mems,
         "cells": cells,
     }
 
 
 ROTATOR = "Rotator"
+# How Yosys names a coordinate memory (module mem_<depth>x<width>, instance mem*_ext).
+COORD_MEMORY_RE = r"\S*mem\S*"
 
 
 def ecp5_breakdown(runner: Runner, yosys: str, src_list: str, mods: list[str], mem_modules: list[str],

@@ -2,18 +2,39 @@ package bpaccel
 
 import chisel3.util.log2Ceil
 
+/** The two architectures the generator builds; both have the same ports,
+  * result beats and schedule (which pairs meet in which lane, in which order).
+  *
+  *  - [[Arch.Seed]]: the published design: 6m striped dual-port memories, an
+  *    A/B address sequencer and a rotator.
+  *  - [[Arch.Stream]]: one memory read per cycle feeds an m-deep shift register
+  *    (the B window); A blocks sit in registers, the next one captured from
+  *    the window as it passes. No rotator, memory independent of m.
+  */
+sealed abstract class Arch(val name: String, val id: Int)
+object Arch {
+  case object Seed   extends Arch("seed", 0)
+  case object Stream extends Arch("stream", 1)
+  val all: Seq[Arch] = Seq(Seed, Stream)
+  def fromName(name: String): Arch =
+    all.find(_.name == name).getOrElse(
+      throw new IllegalArgumentException(s"arch must be one of ${all.map(_.name).mkString(", ")}, got arch = $name")
+    )
+}
+
 /** Every parameter of the generator, checked once here so that every module
   * can trust them.
   *
   * @param m                parallelism: lanes, i.e. pair tests per cycle (any m >= 1)
-  * @param capacity         most objects one run can hold; a multiple of m
+  * @param capacity         most objects one run can hold; for the seed a multiple of m
   * @param keyWidth         bits of one coordinate key (order-preserving image of a float32)
-  * @param resultQueueDepth result beats buffered before the sequencer must stall
+  * @param resultQueueDepth result beats buffered before the schedule must stall
   * @param memoryOutputStages registers after each memory's read data. FPGA synthesis folds
   *                         the first into the block RAM's synchronous read, so it takes
-  *                         two for the rotator to start from a fabric register (measured:
+  *                         two for the logic to start from a fabric register (measured:
   *                         with one, the BRAM's clock-to-out fed the rotator directly)
   * @param debugPort        add a port that shows every lane's (i, j, valid) per cycle, for tests
+  * @param arch             which architecture to build (see [[Arch]])
   */
 case class AccelParams(
   m: Int = 8,
@@ -21,12 +42,13 @@ case class AccelParams(
   keyWidth: Int = 32,
   resultQueueDepth: Int = 16,
   memoryOutputStages: Int = 2,
-  debugPort: Boolean = false
+  debugPort: Boolean = false,
+  arch: Arch = Arch.Seed
 ) {
   require(m >= 1, s"parallelism m must be at least 1, got m = $m")
   require(capacity >= 2, s"capacity must be at least 2 objects, got capacity = $capacity")
   require(
-    capacity % m == 0,
+    arch != Arch.Seed || capacity % m == 0,
     s"capacity must be a multiple of m so the objects stripe evenly: capacity = $capacity, m = $m"
   )
   require(
@@ -36,8 +58,8 @@ case class AccelParams(
   require(keyWidth >= 1 && keyWidth <= 64, s"keyWidth must lie in 1..64, got keyWidth = $keyWidth")
   require(m < (1 << 16) && capacity.toLong < (1L << 32), s"m must fit 16 bits and capacity 32 bits, got m = $m, capacity = $capacity")
 
-  /** Rows of each of the m memories of a coordinate buffer. */
-  val depth: Int = capacity / m
+  /** Rows of each of the m striped memories of the seed architecture. */
+  val depth: Int = (capacity / m).max(1)
 
   /** Bits of an object index 0 .. capacity-1. */
   val indexWidth: Int = log2Ceil(capacity).max(1)
@@ -54,21 +76,44 @@ case class AccelParams(
   /** Bits of a lane number / rotation amount 0 .. m-1. */
   val laneWidth: Int = log2Ceil(m).max(1)
 
-  /** Cycles from an issue of the sequencer to its hit mask: memory read,
-    * memory output registers, rotator register, comparator register.
+  /** Read events from a memory address to its data at the stream's window
+    * entry: the memory's own read plus the output registers.
     */
-  val pipelineLatency: Int = 1 + memoryOutputStages + 2
+  val readLatency: Int = 1 + memoryOutputStages
 
-  /** Cycles a run of n >= 2 objects takes beyond its issue cycles when the
+  /** Cycles from an issue to its hit mask at the result queue. Seed: memory
+    * read, memory output registers, rotator register, comparator register.
+    * Stream: the operands are already registers; comparator register, AND register.
+    */
+  val pipelineLatency: Int = arch match {
+    case Arch.Seed   => 1 + memoryOutputStages + 2
+    case Arch.Stream => 2
+  }
+
+  /** Cycles a run of n >= 2 objects takes after its issue cycles when the
     * consumer never stalls: the pipeline's latency plus the cycle that sees it
     * drained (the result queue passes beats through in the cycle they arrive).
     */
   val runOverheadCycles: Int = pipelineLatency + 1
 
+  /** Cycles between the start and the first issue of a run of n >= 2 objects.
+    * Stream: the window must hold objects 1..m (the load shifted in objects
+    * 1..min(n-1, m), so m+1-n more shifts when n <= m) while the first
+    * readLatency reads travel to the window's entry; both at once.
+    */
+  def startupCycles(n: Long): Long = arch match {
+    case Arch.Seed                => 0
+    case Arch.Stream if n < 2     => 0
+    case Arch.Stream              => math.max(m + 1 - n, readLatency.toLong)
+  }
+
+  /** Every cycle of a run of n objects beyond issues and stalls. */
+  def fixedCycles(n: Long): Long = if (n < 2) 0 else startupCycles(n) + runOverheadCycles
+
   require(
-    resultQueueDepth >= pipelineLatency + 2,
-    s"resultQueueDepth must be at least pipelineLatency + 2 = ${pipelineLatency + 2} " +
-      s"so a consumer that is always ready never stalls the sequencer, got $resultQueueDepth"
+    resultQueueDepth >= pipelineLatency + 3,
+    s"resultQueueDepth must be at least pipelineLatency + 3 = ${pipelineLatency + 3} " +
+      s"so a consumer that is always ready never stalls the schedule, got $resultQueueDepth"
   )
 
   /** Width of a counter; 64 bits cannot overflow within any run this design can hold. */

@@ -3,7 +3,8 @@ package bpaccel
 import chisel3._
 import chisel3.util._
 
-/** Top level: buffers, sequencer, rotator, comparator array, result queue.
+/** Top level, shared by both architectures: loader, run control, the
+  * architecture's engine and the result queue.
   *
   * Protocol: load boxes through `load` (object indices count from 0 in load
   * order), then send n on `start`. Results arrive on `result` as beats of one
@@ -13,13 +14,10 @@ import chisel3.util._
   * the capacity or than the boxes loaded ends the run at once with an error
   * and no results, never with a partial answer.
   *
-  * Back-pressure: the sequencer only issues a cycle when the result queue is
-  * sure to have room for it once it leaves the pipeline, so the pipeline
-  * itself never stalls and no hit is ever dropped or duplicated.
-  *
-  * Pipeline, one schedule cycle per clock when unstalled:
-  * issue -> memory read -> memory output registers -> rotator register ->
-  * comparator/AND register -> result queue (flow-through).
+  * Back-pressure by credits: the engine only issues a schedule cycle when the
+  * result queue is sure to have room for it once it leaves the pipeline, so
+  * the pipeline after the issue never stalls and no hit is ever dropped or
+  * duplicated.
   */
 class BroadPhaseAccel(val p: AccelParams) extends Module {
   val io = IO(new Bundle {
@@ -32,217 +30,56 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
     val debug    = if (p.debugPort) Some(Output(new DebugProbe(p))) else None
   })
 
-  private val m = p.m
+  val loader  = Module(new Loader(p))
+  val control = Module(new RunControl(p))
+  val engine = p.arch match {
+    case Arch.Seed   => Module(new SeedEngine(p))
+    case Arch.Stream => Module(new StreamEngine(p))
+  }
+  // A beat that meets an empty queue and a ready consumer passes in the same cycle.
+  val queue = Module(new Queue(new ResultBeat(p), p.resultQueueDepth, flow = true))
 
-  val buffer    = Module(new CoordBuffer(p))
-  val sequencer = Module(new AddressSequencer(p))
-  val compare   = Module(new ComparatorArray(p))
-  val queue     = Module(new ResultQueue(p))
-
-  // ---- control state ----
-  val busy     = RegInit(false.B)
-  val done     = RegInit(false.B)
-  val error    = RegInit(AccelError.None.U(AccelError.width.W))
-  val loaded   = RegInit(0.U(p.countWidth.W))
-  val loadLane = RegInit(0.U(p.laneWidth.W))
-  val loadRow  = RegInit(0.U(p.rowWidth.W))
-  val overflow = RegInit(false.B)
-
-  val cycles      = RegInit(0.U(p.counterWidth.W))
-  // Load cycles of the run being loaded: from its first accepted box to the
-  // cycle that accepts its start, gaps included, since the device belongs to
-  // that run from its first box on. Published in loadCycles at the start.
-  val loading       = RegInit(false.B)
-  val loadingCycles = RegInit(0.U(p.counterWidth.W))
-  val loadCycles    = RegInit(0.U(p.counterWidth.W))
-  val issueCycles = RegInit(0.U(p.counterWidth.W))
-  val stallCycles = RegInit(0.U(p.counterWidth.W))
-  val hits        = RegInit(0.U(p.counterWidth.W))
-  val drainCycles = RegInit(0.U(log2Ceil(p.runOverheadCycles + 1).W))
-
-  io.start.ready := !busy
   // A start in the same cycle wins, so a box is never loaded into the next run by accident.
-  io.load.ready := !busy && !io.start.valid
+  io.load.ready       := !control.io.status.busy && !io.start.valid
+  loader.io.load.valid := io.load.fire
+  loader.io.load.bits  := io.load.bits
+  loader.io.clear      := io.start.fire
 
-  // ---- loading ----
-  val full = loaded === p.capacity.U
-  buffer.io.write.valid     := io.load.fire && !full
-  buffer.io.write.bits.lane := loadLane
-  buffer.io.write.bits.row  := loadRow
-  buffer.io.write.bits.box  := io.load.bits
-  when(io.load.fire) {
-    when(full) {
-      overflow := true.B
-      error    := AccelError.LoadOverflow.U
-    }.otherwise {
-      loaded := loaded + 1.U
-      if (m == 1) loadRow := loadRow + 1.U
-      else {
-        val lastLane = loadLane === (m - 1).U
-        loadLane := Mux(lastLane, 0.U, loadLane + 1.U)
-        when(lastLane) { loadRow := loadRow + 1.U }
-      }
-    }
-  }
+  control.io.start <> io.start
+  control.io.loadFire := io.load.fire
+  control.io.loaded   := loader.io.loaded
+  control.io.overflow := loader.io.overflow
 
-  when(io.load.fire && !loading) {
-    loading       := true.B
-    loadingCycles := 1.U
-  }.elsewhen(loading) {
-    loadingCycles := loadingCycles + 1.U
-  }
+  engine.io.write   := loader.io.write
+  engine.io.launch  := control.io.launch
+  // Credits, registered so that no adder sits before the engine's enables:
+  // queue count + cycles in flight grows by at most one a cycle, so room for
+  // one more last cycle means room now.
+  engine.io.advance := RegNext(
+    queue.io.count +& engine.io.activity.inFlight +& 1.U < p.resultQueueDepth.U,
+    false.B
+  )
+  control.io.engine := engine.io.activity
 
-  // ---- starting ----
-  sequencer.io.start.valid := false.B
-  sequencer.io.start.bits  := io.start.bits
-  when(io.start.fire) {
-    val n = io.start.bits
-    loaded      := 0.U
-    loadLane    := 0.U
-    loadRow     := 0.U
-    overflow    := false.B
-    cycles      := 0.U
-    loadCycles  := Mux(loading, loadingCycles + 1.U, 1.U) // + the start cycle itself
-    loading     := false.B
-    issueCycles := 0.U
-    stallCycles := 0.U
-    hits        := 0.U
-    drainCycles := 0.U
-    val code = Mux(
-      overflow,
-      AccelError.LoadOverflow.U,
-      Mux(n > p.capacity.U, AccelError.CountOverCapacity.U, Mux(n > loaded, AccelError.CountOverLoaded.U, AccelError.None.U))
-    )
-    error := code
-    // Runs with errors, and runs with nothing to pair, end at once.
-    val runs = code === AccelError.None.U && n >= 2.U
-    busy                     := runs
-    done                     := !runs
-    sequencer.io.start.valid := runs
-  }
-
-  // ---- pipeline ----
-  // Valid bits of the cycles in flight between issue and the result queue.
-  val inFlight = Wire(UInt(log2Ceil(p.pipelineLatency + 1).W))
-  sequencer.io.advance := queue.io.count +& inFlight < p.resultQueueDepth.U
-  val issue = sequencer.io.issue
-
-  buffer.io.readEnable := busy
-  buffer.io.aRow       := issue.bits.aRow
-  buffer.io.bRows      := issue.bits.bRows
-
-  class Meta extends Bundle {
-    val iBase    = UInt(p.indexWidth.W)
-    val jBase    = UInt(p.indexWidth.W)
-    val laneMask = UInt(m.W)
-    val rotate   = UInt(p.laneWidth.W)
-    val probeI   = Vec(m, UInt(p.indexWidth.W))       // only used with the debug port
-    val probeJ   = Vec(m, UInt(p.indexWidth.W))
-  }
-  val issued = Wire(Valid(new Meta))
-  issued.valid              := issue.valid
-  issued.bits.iBase         := issue.bits.iBase
-  issued.bits.jBase         := issue.bits.jBase
-  issued.bits.laneMask      := issue.bits.laneMask
-  issued.bits.rotate        := issue.bits.rotate
-  if (p.debugPort) {
-    // The objects each lane really sees: derived from the row addresses given
-    // to the memories and the rotator's selection, not from iBase/jBase.
-    issued.bits.probeI := VecInit(Seq.tabulate(m)(k => (issue.bits.aRow * m.U + k.U)(p.indexWidth - 1, 0)))
-    val portObjects = VecInit(Seq.tabulate(m)(k => (issue.bits.bRows(k) * m.U + k.U)(p.indexWidth - 1, 0)))
-    issued.bits.probeJ := Rotator(portObjects, issue.bits.rotate)
-  } else {
-    issued.bits.probeI := DontCare
-    issued.bits.probeJ := DontCare
-  }
-
-  private def stage(x: Valid[Meta]): Valid[Meta] = {
-    val r = Wire(Valid(new Meta))
-    r.valid := RegNext(x.valid, false.B)
-    r.bits  := RegNext(x.bits)
-    r
-  }
-
-  // Memory read (1 cycle) and the memory output registers.
-  val atMemory = stage(issued)
-  val memoryStages = Seq.iterate((buffer.io.a, buffer.io.b, atMemory), p.memoryOutputStages + 1) {
-    case (a, b, meta) => (RegNext(a), RegNext(b), stage(meta))
-  }
-  val (memA, memB, atBuffered) = memoryStages.last
-  // Rotator, registered.
-  val rotatedB  = RegNext(Rotator(memB, atBuffered.bits.rotate))
-  val alignedA  = RegNext(memA)
-  val atRotated = stage(atBuffered)
-  // Comparators and AND gates, registered.
-  compare.io.a := alignedA
-  compare.io.b := rotatedB
-  val hitMask   = Reg(UInt(m.W))
-  hitMask := compare.io.hits & atRotated.bits.laneMask
-  val atCompare = stage(atRotated)
-
-  val stages = memoryStages.map(_._3) ++ Seq(atRotated, atCompare)
-  require(stages.length == p.pipelineLatency)
-  inFlight := PopCount(stages.map(_.valid))
-
-  queue.io.enq.valid      := atCompare.valid && hitMask.orR
-  queue.io.enq.bits.iBase := atCompare.bits.iBase
-  queue.io.enq.bits.jBase := atCompare.bits.jBase
-  queue.io.enq.bits.mask  := hitMask
+  val beat = engine.io.out
+  queue.io.enq.valid := beat.valid && beat.bits.mask.orR
+  queue.io.enq.bits  := beat.bits
   assert(!queue.io.enq.valid || queue.io.enq.ready, "result queue overflow: credit accounting is broken")
   io.result <> queue.io.deq
 
-  // ---- run bookkeeping ----
-  when(busy) {
-    cycles := cycles + 1.U
-    when(issue.valid) {
-      issueCycles := issueCycles + 1.U
-    }.elsewhen(sequencer.io.active) {
-      stallCycles := stallCycles + 1.U
-    }.otherwise {
-      // Draining: the first runOverheadCycles cycles are the pipeline's
-      // fixed latency; any beyond are spent waiting for the consumer.
-      when(drainCycles === p.runOverheadCycles.U) {
-        stallCycles := stallCycles + 1.U
-      }.otherwise {
-        drainCycles := drainCycles + 1.U
-      }
-      when(inFlight === 0.U && queue.io.count === 0.U) {
-        busy := false.B
-        done := true.B
-      }
-    }
-  }
-  // Counted as beats enter the queue, from the registered hit mask: counting at
-  // the consumer put the queue's read multiplexer, a popcount and a 64-bit add
-  // on one path (the critical one on ECP5). Every queued beat is delivered
-  // before done rises, so after a run this equals the pairs handed over.
-  when(queue.io.enq.fire) {
-    hits := hits + PopCount(hitMask)
-  }
+  control.io.queuedHits.valid := queue.io.enq.fire
+  control.io.queuedHits.bits  := PopCount(beat.bits.mask)
+  control.io.queueEmpty       := queue.io.count === 0.U
 
-  io.status.busy   := busy
-  io.status.done   := done
-  io.status.error  := error
-  io.status.loaded := loaded
+  io.status   := control.io.status
+  io.counters := control.io.counters
 
+  io.info.arch              := p.arch.id.U
   io.info.m                 := p.m.U
   io.info.capacity          := p.capacity.U
   io.info.keyWidth          := p.keyWidth.U
   io.info.runOverheadCycles := p.runOverheadCycles.U
+  io.info.readLatency       := (if (p.arch == Arch.Stream) p.readLatency else 0).U
 
-  io.counters.loadCycles  := loadCycles
-  io.counters.cycles      := cycles
-  io.counters.issueCycles := issueCycles
-  io.counters.stallCycles := stallCycles
-  io.counters.hits        := hits
-
-  io.debug.foreach { d =>
-    d.cycleValid := atCompare.valid
-    for (k <- 0 until m) {
-      d.lanes(k).valid := atCompare.valid && atCompare.bits.laneMask(k)
-      d.lanes(k).i     := atCompare.bits.probeI(k)
-      d.lanes(k).j     := atCompare.bits.probeJ(k)
-      d.lanes(k).hit   := hitMask(k)
-    }
-  }
+  io.debug.foreach(_ := engine.io.probe.get)
 }

@@ -20,24 +20,24 @@ class ResultBeat(p: AccelParams) extends Bundle {
 }
 
 /** Error codes of a run, also written into the C header. */
-object AccelError {
-  val width = 2
-  val None              = 0
-  val CountOverCapacity = 1 // start(n) with n > capacity
-  val CountOverLoaded   = 2 // start(n) with fewer than n boxes loaded
-  val LoadOverflow      = 3 // more than capacity boxes were loaded
-  val names: Seq[(String, Int)] = Seq(
+object AccelError extends ChiselEnum {
+  val None              = Value(0.U) // the run is fine
+  val CountOverCapacity = Value(1.U) // start(n) with n > capacity
+  val CountOverLoaded   = Value(2.U) // start(n) with fewer than n boxes loaded
+  val LoadOverflow      = Value(3.U) // more than capacity boxes were loaded
+  val names: Seq[(String, Type)] = Seq(
     "NONE" -> None,
     "COUNT_OVER_CAPACITY" -> CountOverCapacity,
     "COUNT_OVER_LOADED" -> CountOverLoaded,
     "LOAD_OVERFLOW" -> LoadOverflow
   )
+  def code(e: Type): Int = e.litValue.toInt
 }
 
 class AccelStatus(p: AccelParams) extends Bundle {
   val busy   = Bool()
   val done   = Bool() // the last run ended (with or without error) and nothing started since
-  val error  = UInt(AccelError.width.W)
+  val error  = AccelError()
   val loaded = UInt(p.countWidth.W)
 }
 
@@ -45,7 +45,7 @@ class AccelCounters(p: AccelParams) extends Bundle {
   val loadCycles  = UInt(p.counterWidth.W) // first box loaded .. start accepted, both included (1 if no box)
   val cycles      = UInt(p.counterWidth.W) // start accepted .. done
   val issueCycles = UInt(p.counterWidth.W) // cycles the comparator array was given work
-  val stallCycles = UInt(p.counterWidth.W) // cycles the sequencer waited on the result queue
+  val stallCycles = UInt(p.counterWidth.W) // cycles the schedule waited on the result queue
   val hits        = UInt(p.counterWidth.W) // pairs reported (all handed to the consumer by done)
 }
 
@@ -66,8 +66,50 @@ class DebugProbe(p: AccelParams) extends Bundle {
   * it drives is the one its header describes.
   */
 class AccelInfo extends Bundle {
+  val arch              = UInt(8.W) // Arch.id: 0 seed, 1 stream
   val m                 = UInt(16.W)
   val capacity          = UInt(32.W)
   val keyWidth          = UInt(8.W)
   val runOverheadCycles = UInt(8.W)
+  val readLatency       = UInt(8.W) // stream: startup is max(m + 1 - n, readLatency) cycles
+}
+
+/** The ports every architecture's engine offers the shared top level. */
+class EngineIO(p: AccelParams) extends Bundle {
+  val write    = Flipped(Valid(new LoadWrite(p)))
+  val launch   = Flipped(Valid(UInt(p.countWidth.W))) // a run of n >= 2 objects, all loaded
+  val advance  = Input(Bool())                        // the result queue has room for one more issue
+  val activity = Output(new EngineActivity(p))
+  val out      = Valid(new ResultBeat(p))             // one per issued cycle, mask = hits
+  val probe    = if (p.debugPort) Some(Output(new DebugProbe(p))) else None
+}
+
+/** An architecture's datapath: memories, schedule and comparators. */
+abstract class Engine(val p: AccelParams) extends Module {
+  val io = IO(new EngineIO(p))
+
+  /** Drives the result and the debug probe from the pipeline's last stage. */
+  protected def emit(
+    valid: Bool,
+    iBase: UInt,
+    jBase: UInt,
+    laneMask: UInt,
+    probeI: Vec[UInt],
+    probeJ: Vec[UInt],
+    hitMask: UInt
+  ): Unit = {
+    io.out.valid      := valid
+    io.out.bits.iBase := iBase
+    io.out.bits.jBase := jBase
+    io.out.bits.mask  := hitMask
+    io.probe.foreach { d =>
+      d.cycleValid := valid
+      for (k <- 0 until p.m) {
+        d.lanes(k).valid := valid && laneMask(k)
+        d.lanes(k).i     := probeI(k)
+        d.lanes(k).j     := probeJ(k)
+        d.lanes(k).hit   := hitMask(k)
+      }
+    }
+  }
 }

@@ -18,10 +18,19 @@ object EmitVerilog {
     queueDepth: Int = AccelParams().resultQueueDepth,
     memoryOutputStages: Int = AccelParams().memoryOutputStages,
     debugPort: Boolean = false,
+    arch: String = AccelParams().arch.name,
     targetDir: Path = Paths.get("generated")
   ) {
     def params: AccelParams =
-      AccelParams(m, capacity.getOrElse(AccelParams.defaultCapacity(m)), keyWidth, queueDepth, memoryOutputStages, debugPort)
+      AccelParams(
+        m,
+        capacity.getOrElse(AccelParams.defaultCapacity(m)),
+        keyWidth,
+        queueDepth,
+        memoryOutputStages,
+        debugPort,
+        Arch.fromName(arch)
+      )
   }
 
   /** firtool options that keep the output plain enough for Yosys, Verilator and vendor tools. */
@@ -39,8 +48,21 @@ object EmitVerilog {
       Seq(ChiselGeneratorAnnotation(() => new BroadPhaseAccel(p))) ++ firtoolOptions.map(FirtoolOption(_))
     )
     Files.writeString(targetDir.resolve("bpaccel_params.h"), CHeader(p))
+    Files.writeString(targetDir.resolve(lintWaivers), lintWaiverText)
     targetDir.resolve("filelist.f")
   }
+
+  /** Verilator configuration for `verilator --lint-only -Wall lint_waivers.vlt -F filelist.f`. */
+  val lintWaivers = "lint_waivers.vlt"
+
+  /** firtool builds the result queue's storage (chisel3.util.Queue's Mem, read
+    * combinationally) as a module with a read clock it never uses.
+    */
+  private val lintWaiverText =
+    "`verilator_config\n" +
+      "// chisel3.util.Queue's memory reads combinationally: firtool's ram module has an unused read clock.\n" +
+      "lint_off -rule UNUSEDSIGNAL -file \"*ram_*.sv\" -match \"*R0_clk*\"\n"
+
 
   def main(args: Array[String]): Unit = {
     val parser = new scopt.OptionParser[Options]("EmitVerilog") {
@@ -55,6 +77,9 @@ object EmitVerilog {
         .action((v, o) => o.copy(memoryOutputStages = v))
         .text("registers after the memories' read data (default 2)")
       opt[Boolean]("debug-port").action((v, o) => o.copy(debugPort = v)).text("add the per-lane debug probe")
+      opt[String]("arch")
+        .action((v, o) => o.copy(arch = v))
+        .text(s"architecture: ${Arch.all.map(_.name).mkString(" or ")} (default ${AccelParams().arch.name})")
       opt[String]("target-dir").action((v, o) => o.copy(targetDir = Paths.get(v))).text("output folder")
     }
     // Parameters are validated when the case class is built; report that as a usage error.

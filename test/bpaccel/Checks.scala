@@ -8,7 +8,7 @@ trait Checks extends Matchers {
   /** Pairs, counters and cycle accounting of one run against the reference. */
   def checkRun(p: AccelParams, boxes: Seq[Box], out: RunOutcome, consumerNeverStalls: Boolean): Unit = {
     val n = boxes.length
-    out.error shouldBe AccelError.None
+    out.error shouldBe AccelError.code(AccelError.None)
     out.pairs.foreach { case (i, j) =>
       withClue(s"pair ($i, $j): ") { i should be < j; j should be < n }
     }
@@ -20,14 +20,16 @@ trait Checks extends Matchers {
     out.cycles shouldBe out.driverCycles
     out.loadCycles shouldBe out.driverLoadCycles
     out.loadCycles shouldBe n + 1L // the driver loads one box a cycle, then starts
-    val overhead = if (n < 2) 0 else p.runOverheadCycles
-    out.cycles shouldBe out.issueCycles + out.stallCycles + overhead
+    out.cycles shouldBe out.issueCycles + out.stallCycles + p.fixedCycles(n)
     if (consumerNeverStalls) out.stallCycles shouldBe 0
   }
 
   /** The hardware's per-lane probes against the golden model, cycle by cycle. */
   def checkSchedule(p: AccelParams, n: Int, out: RunOutcome): Unit = {
-    val golden = SeedScheduleModel.cycles(n, p.m)
+    val golden = p.arch match {
+      case Arch.Seed   => SeedScheduleModel.cycles(n, p.m)
+      case Arch.Stream => StreamScheduleModel.cycles(n, p.m, p.readLatency)
+    }
     out.probeCycles.length shouldBe golden.length
     for (((hw, gm), c) <- out.probeCycles.zip(golden).zipWithIndex)
       withClue(s"m=${p.m} n=$n cycle $c: ") { hw shouldBe gm }

@@ -66,7 +66,7 @@ class GeneratedScenesSpec extends AnyFlatSpec with Simulators with Checks with S
       drv.idleInputs()
       forAll(scenarioGen(p), MinSuccessful(org.scalactic.anyvals.PosInt.from(scenarios).get)) { s =>
         val out = drv.run(s.boxes, s.ready)
-        out.error shouldBe AccelError.None
+        out.error shouldBe AccelError.code(AccelError.None)
         out.pairs.distinct.length shouldBe out.pairs.length
         out.pairs.toSet shouldBe reference(s.boxes)
         out.hits shouldBe out.pairs.length.toLong

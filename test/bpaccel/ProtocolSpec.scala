@@ -6,116 +6,125 @@ import org.scalatest.flatspec.AnyFlatSpec
 
 import scala.util.Random
 
-/** Errors instead of silent truncation, and recovery after runs and resets. */
+/** Errors instead of silent truncation, and recovery after runs and resets, for both architectures. */
 class ProtocolSpec extends AnyFlatSpec with Simulators with Checks {
-  private val p = AccelParams(m = 4, capacity = 16)
+  private val configurations = Seq(
+    AccelParams(m = 4, capacity = 16),
+    AccelParams(m = 4, capacity = 18, arch = Arch.Stream) // the stream needs no multiple of m
+  )
 
-  private def withDut(body: (BroadPhaseAccel, AccelDriver) => Unit): Unit =
-    onVerilator(p) { dut =>
-      val drv = new AccelDriver(dut)
-      drv.idleInputs()
-      body(dut, drv)
-    }
+  for (p <- configurations) {
+    val arch = s"(${p.arch.name})"
 
-  private def boxes(n: Int, seed: Int) = Box.Scenes.uniform(new Random(seed), n, p.keyWidth, 30, 10)
+    def withDut(body: (BroadPhaseAccel, AccelDriver) => Unit): Unit =
+      onVerilator(p) { dut =>
+        val drv = new AccelDriver(dut)
+        drv.idleInputs()
+        body(dut, drv)
+      }
 
-  "The info port" should "report the configuration the C header describes" in {
-    withDut { (dut, _) =>
-      dut.io.info.m.expect(p.m.U)
-      dut.io.info.capacity.expect(p.capacity.U)
-      dut.io.info.keyWidth.expect(p.keyWidth.U)
-      dut.io.info.runOverheadCycles.expect(p.runOverheadCycles.U)
-    }
-  }
+    def boxes(n: Int, seed: Int) = Box.Scenes.uniform(new Random(seed), n, p.keyWidth, 30, 10)
 
-  "A load beyond the capacity" should "raise LoadOverflow at once and fail the next start without results" in {
-    withDut { (dut, drv) =>
-      drv.load(boxes(p.capacity, 1))
-      dut.io.status.error.expect(AccelError.None.U)
-      dut.io.status.loaded.expect(p.capacity.U)
-      drv.load(boxes(1, 2))
-      dut.io.status.error.expect(AccelError.LoadOverflow.U)
-      val out = drv.start(p.capacity)
-      out.error shouldBe AccelError.LoadOverflow
-      out.pairs shouldBe empty
-      out.cycles shouldBe 0
-      // The error does not stick: a correct run follows.
-      val b = boxes(9, 3)
-      checkRun(p, b, drv.run(b), consumerNeverStalls = true)
-    }
-  }
-
-  "A start with n above the capacity" should "fail with CountOverCapacity" in {
-    withDut { (_, drv) =>
-      drv.load(boxes(p.capacity, 4))
-      val out = drv.start(p.capacity + 1)
-      out.error shouldBe AccelError.CountOverCapacity
-      out.pairs shouldBe empty
-    }
-  }
-
-  "A start with n above the boxes loaded" should "fail with CountOverLoaded" in {
-    withDut { (_, drv) =>
-      drv.load(boxes(5, 5))
-      val out = drv.start(6)
-      out.error shouldBe AccelError.CountOverLoaded
-      out.pairs shouldBe empty
-      out.hits shouldBe 0
-    }
-  }
-
-  "Runs with fewer than two objects" should "finish at once with no pairs and no error" in {
-    withDut { (_, drv) =>
-      for (n <- Seq(0, 1)) {
-        val out = drv.run(boxes(n, 6))
-        out.error shouldBe AccelError.None
-        out.pairs shouldBe empty
-        out.cycles shouldBe 0
+    "The info port" should s"report the configuration the C header describes $arch" in {
+      withDut { (dut, _) =>
+        dut.io.info.arch.expect(p.arch.id.U)
+        dut.io.info.m.expect(p.m.U)
+        dut.io.info.capacity.expect(p.capacity.U)
+        dut.io.info.keyWidth.expect(p.keyWidth.U)
+        dut.io.info.runOverheadCycles.expect(p.runOverheadCycles.U)
+        dut.io.info.readLatency.expect((if (p.arch == Arch.Stream) p.readLatency else 0).U)
       }
     }
-  }
 
-  "The load-cycle counter" should "count from the first box to the start, pauses included" in {
-    withDut { (_, drv) =>
-      drv.load(boxes(3, 10))
-      drv.idle(5) // the host pauses: the device still belongs to this run
-      drv.load(boxes(2, 11))
-      val out = drv.start(5)
-      out.loadCycles shouldBe 3 + 5 + 2 + 1
-      out.loadCycles shouldBe out.driverLoadCycles
-      // A start with nothing loaded costs its own cycle only.
-      drv.idle(4)
-      drv.start(0).loadCycles shouldBe 1
+    "A load beyond the capacity" should s"raise LoadOverflow at once and fail the next start without results $arch" in {
+      withDut { (dut, drv) =>
+        drv.load(boxes(p.capacity, 1))
+        dut.io.status.error.expect(AccelError.None)
+        dut.io.status.loaded.expect(p.capacity.U)
+        drv.load(boxes(1, 2))
+        dut.io.status.error.expect(AccelError.LoadOverflow)
+        val out = drv.start(p.capacity)
+        out.error shouldBe AccelError.code(AccelError.LoadOverflow)
+        out.pairs shouldBe empty
+        out.cycles shouldBe 0
+        // The error does not stick: a correct run follows.
+        val b = boxes(9, 3)
+        checkRun(p, b, drv.run(b), consumerNeverStalls = true)
+      }
     }
-  }
 
-  "Loading" should "be refused while a run is busy" in {
-    withDut { (dut, drv) =>
-      drv.load(boxes(16, 7))
-      drv.pulseStart(16)
-      dut.io.status.busy.expect(true.B)
-      dut.io.load.ready.expect(false.B)
-      dut.io.start.ready.expect(false.B)
+    "A start with n above the capacity" should s"fail with CountOverCapacity $arch" in {
+      withDut { (_, drv) =>
+        drv.load(boxes(p.capacity, 4))
+        val out = drv.start(p.capacity + 1)
+        out.error shouldBe AccelError.code(AccelError.CountOverCapacity)
+        out.pairs shouldBe empty
+      }
     }
-  }
 
-  "A reset in the middle of a run" should "leave an idle accelerator that runs the next scene exactly" in {
-    withDut { (dut, drv) =>
-      drv.load(boxes(16, 8))
-      drv.pulseStart(16)
-      dut.io.result.ready.poke(true.B)
-      dut.clock.step(7)
-      dut.io.status.busy.expect(true.B)
-      dut.reset.poke(true.B)
-      dut.clock.step()
-      dut.reset.poke(false.B)
-      dut.io.result.ready.poke(false.B)
-      dut.io.status.busy.expect(false.B)
-      dut.io.status.done.expect(false.B)
-      dut.io.status.loaded.expect(0.U)
-      dut.io.result.valid.expect(false.B)
-      val b = boxes(13, 9)
-      checkRun(p, b, drv.run(b, c => c % 3 != 0), consumerNeverStalls = false)
+    "A start with n above the boxes loaded" should s"fail with CountOverLoaded $arch" in {
+      withDut { (_, drv) =>
+        drv.load(boxes(5, 5))
+        val out = drv.start(6)
+        out.error shouldBe AccelError.code(AccelError.CountOverLoaded)
+        out.pairs shouldBe empty
+        out.hits shouldBe 0
+      }
+    }
+
+    "Runs with fewer than two objects" should s"finish at once with no pairs and no error $arch" in {
+      withDut { (_, drv) =>
+        for (n <- Seq(0, 1)) {
+          val out = drv.run(boxes(n, 6))
+          out.error shouldBe AccelError.code(AccelError.None)
+          out.pairs shouldBe empty
+          out.cycles shouldBe 0
+        }
+      }
+    }
+
+    "The load-cycle counter" should s"count from the first box to the start, pauses included $arch" in {
+      withDut { (_, drv) =>
+        drv.load(boxes(3, 10))
+        drv.idle(5) // the host pauses: the device still belongs to this run
+        drv.load(boxes(2, 11))
+        val out = drv.start(5)
+        out.loadCycles shouldBe 3 + 5 + 2 + 1
+        out.loadCycles shouldBe out.driverLoadCycles
+        // A start with nothing loaded costs its own cycle only.
+        drv.idle(4)
+        drv.start(0).loadCycles shouldBe 1
+      }
+    }
+
+    "Loading" should s"be refused while a run is busy $arch" in {
+      withDut { (dut, drv) =>
+        drv.load(boxes(16, 7))
+        drv.pulseStart(16)
+        dut.io.status.busy.expect(true.B)
+        dut.io.load.ready.expect(false.B)
+        dut.io.start.ready.expect(false.B)
+      }
+    }
+
+    "A reset in the middle of a run" should s"leave an idle accelerator that runs the next scene exactly $arch" in {
+      withDut { (dut, drv) =>
+        drv.load(boxes(16, 8))
+        drv.pulseStart(16)
+        dut.io.result.ready.poke(true.B)
+        dut.clock.step(7)
+        dut.io.status.busy.expect(true.B)
+        dut.reset.poke(true.B)
+        dut.clock.step()
+        dut.reset.poke(false.B)
+        dut.io.result.ready.poke(false.B)
+        dut.io.status.busy.expect(false.B)
+        dut.io.status.done.expect(false.B)
+        dut.io.status.loaded.expect(0.U)
+        dut.io.result.valid.expect(false.B)
+        val b = boxes(13, 9)
+        checkRun(p, b, drv.run(b, c => c % 3 != 0), consumerNeverStalls = false)
+      }
     }
   }
 }

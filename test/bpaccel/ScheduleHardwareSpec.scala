@@ -5,13 +5,15 @@ import org.scalatest.flatspec.AnyFlatSpec
 
 import scala.util.Random
 
-/** The generated sequencer, rotator and pipeline against the seed's golden
-  * schedule, cycle by cycle and lane by lane, on Verilator.
+/** The generated schedule against each architecture's golden model, cycle
+  * by cycle and lane by lane, on Verilator: for the seed the sequencer's
+  * addresses through the rotator, for the stream the object tags that travel
+  * through the window and the A registers with the data.
   */
 class ScheduleHardwareSpec extends AnyFlatSpec with Simulators with Checks {
 
-  private def scheduleAllCounts(m: Int, counts: Int => Seq[Int], capacity: Int): Unit = {
-    val p = AccelParams(m = m, capacity = capacity, debugPort = true)
+  private def scheduleAllCounts(m: Int, counts: Int => Seq[Int], capacity: Int, arch: Arch = Arch.Seed): Unit = {
+    val p = AccelParams(m = m, capacity = capacity, debugPort = true, arch = arch)
     onVerilator(p) { dut =>
       val drv = new AccelDriver(dut)
       drv.idleInputs()
@@ -39,6 +41,23 @@ class ScheduleHardwareSpec extends AnyFlatSpec with Simulators with Checks {
         m,
         capacity => (Seq(0, 1, 2, 3, m - 1, m, m + 1, 2 * m - 1, 2 * m, 2 * m + 1, capacity - 1, capacity)).distinct,
         capacity = 3 * m
+      )
+    }
+
+  behavior of "The stream architecture's schedule"
+
+  for (m <- Seq(1, 2, 3, 5, 8))
+    it should s"match the stream golden model for m=$m and every n up to the capacity" in {
+      scheduleAllCounts(m, capacity => 0 to capacity, capacity = 5 * m + 1, arch = Arch.Stream)
+    }
+
+  for (m <- Seq(13, 16))
+    it should s"match the stream golden model for m=$m at small n, around multiples of m and at the capacity" in {
+      scheduleAllCounts(
+        m,
+        capacity => (Seq(0, 1, 2, 3, m - 1, m, m + 1, m + 2, 2 * m - 1, 2 * m, 2 * m + 1, 2 * m + 2, capacity - 1, capacity)).distinct,
+        capacity = 3 * m,
+        arch = Arch.Stream
       )
     }
 }

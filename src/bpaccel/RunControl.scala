@@ -1,0 +1,123 @@
+package bpaccel
+
+import chisel3._
+import chisel3.util._
+
+/** What an engine tells run control each cycle. */
+class EngineActivity(p: AccelParams) extends Bundle {
+  val active   = Bool() // the schedule is not finished (starting up or issuing)
+  val issued   = Bool() // a schedule cycle was issued
+  val stalled  = Bool() // a schedule cycle was ready but the result queue had no room
+  val inFlight = UInt(log2Ceil(p.pipelineLatency + 1).W) // issued cycles not yet at the result queue
+}
+
+/** Starts runs, decodes their errors, ends them, and keeps the counters.
+  *
+  * A start is checked against what was loaded: an error, or fewer than two
+  * objects, ends the run at once with no results. Otherwise the engine is
+  * launched and the run ends once the engine is done, nothing is in flight
+  * and every queued beat was taken.
+  */
+class RunControl(p: AccelParams) extends Module {
+  val io = IO(new Bundle {
+    val start      = Flipped(Decoupled(UInt(p.countWidth.W)))
+    val loadFire   = Input(Bool())
+    val loaded     = Input(UInt(p.countWidth.W))
+    val overflow   = Input(Bool())
+    val launch     = Valid(UInt(p.countWidth.W)) // n >= 2, no error
+    val engine     = Input(new EngineActivity(p))
+    val queuedHits = Flipped(Valid(UInt(log2Ceil(p.m + 1).W))) // pairs entering the result queue
+    val queueEmpty = Input(Bool())
+    val status     = Output(new AccelStatus(p))
+    val counters   = Output(new AccelCounters(p))
+  })
+
+  val busy  = RegInit(false.B)
+  val done  = RegInit(false.B)
+  val error = RegInit(AccelError.None)
+
+  private def counter() = RegInit(0.U(p.counterWidth.W))
+  val cycles      = counter()
+  val issueCycles = counter()
+  val stallCycles = counter()
+  val hits        = counter()
+  val loadCycles  = counter()
+  // Load cycles of the run being loaded: from its first accepted box to the
+  // cycle that accepts its start, pauses included, since the device belongs
+  // to that run from its first box on. Published in loadCycles at the start.
+  val loading       = RegInit(false.B)
+  val loadingCycles = counter()
+  val drainCycles   = RegInit(0.U(log2Ceil(p.runOverheadCycles + 1).W))
+
+  io.start.ready := !busy
+
+  when(io.loadFire && !loading) {
+    loading       := true.B
+    loadingCycles := 1.U
+  }.elsewhen(loading) {
+    loadingCycles := loadingCycles + 1.U
+  }
+
+  io.launch.valid := false.B
+  io.launch.bits  := io.start.bits
+  when(io.start.fire) {
+    val n = io.start.bits
+    val code = MuxCase(
+      AccelError.None,
+      Seq(
+        io.overflow            -> AccelError.LoadOverflow,
+        (n > p.capacity.U)     -> AccelError.CountOverCapacity,
+        (n > io.loaded)        -> AccelError.CountOverLoaded
+      )
+    )
+    error := code
+    val runs = code === AccelError.None && n >= 2.U
+    busy            := runs
+    done            := !runs
+    io.launch.valid := runs
+    loadCycles      := Mux(loading, loadingCycles + 1.U, 1.U) // + the start cycle itself
+    loading         := false.B
+    cycles          := 0.U
+    issueCycles     := 0.U
+    stallCycles     := 0.U
+    hits            := 0.U
+    drainCycles     := 0.U
+  }
+
+  when(busy) {
+    cycles := cycles + 1.U
+    when(io.engine.issued) {
+      issueCycles := issueCycles + 1.U
+    }.elsewhen(io.engine.stalled) {
+      stallCycles := stallCycles + 1.U
+    }.elsewhen(!io.engine.active) {
+      // Draining: the first runOverheadCycles cycles are the pipeline's
+      // fixed latency; any beyond are spent waiting for the consumer.
+      when(drainCycles === p.runOverheadCycles.U) {
+        stallCycles := stallCycles + 1.U
+      }.otherwise {
+        drainCycles := drainCycles + 1.U
+      }
+      when(io.engine.inFlight === 0.U && io.queueEmpty) {
+        busy := false.B
+        done := true.B
+      }
+    }
+  }
+  // Counted as beats enter the queue, from a registered hit mask: counting at
+  // the consumer put the queue's read multiplexer, a popcount and a 64-bit add
+  // on one path. Every queued beat is delivered before done rises.
+  when(io.queuedHits.valid) { hits := hits + io.queuedHits.bits }
+
+  io.status.busy  := busy
+  // A box beyond the capacity shows at once; the next start fails with it.
+  io.status.error  := Mux(io.overflow, AccelError.LoadOverflow, error)
+  io.status.done   := done
+  io.status.loaded := io.loaded
+
+  io.counters.loadCycles  := loadCycles
+  io.counters.cycles      := cycles
+  io.counters.issueCycles := issueCycles
+  io.counters.stallCycles := stallCycles
+  io.counters.hits        := hits
+}

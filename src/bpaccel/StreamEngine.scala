@@ -1,0 +1,217 @@
+package bpaccel
+
+import chisel3._
+import chisel3.util._
+
+/** The stream architecture: the seed's schedule from one memory read a cycle.
+  *
+  * Schedule (the seed's): block b compares A objects base+k (base = b*m) with
+  * B objects s+k, s = base+1 .. n-1, lane k masked once s+k >= n. So the B
+  * objects of consecutive cycles form one stream R: block 0's objects
+  * 1 .. n-1, then block 1's m+1 .. n-1, and so on. In issue cycle t the
+  * window, an m-deep shift register, holds R[t .. t+m-1] (lane k = object
+  * s+k); each issue shifts it by one lane and takes R[t+m] from the single
+  * memory read port at the top. A block's last m-1 lanes already hold the
+  * next block's first objects, so blocks follow each other without a bubble.
+  *
+  * A blocks sit in registers (`a`). The next block's A objects base+m+k pass
+  * the window's top lane in cycle k of the current block; `aNext` captures
+  * them there and is copied into `a` at the block change. Block 0's A
+  * objects and the first window are taken from the load stream the same
+  * way (the window shifts in objects 0 .. m while they are loaded).
+  *
+  * No register has a multiplexer in front of it: every window lane loads
+  * from its neighbour, `aNext` from the top lane, `a` from `aNext` (enables
+  * only). The window's entry chooses between the load port and the memory.
+  *
+  * Startup after the start: the first readLatency reads travel to the entry
+  * and, when n <= m, the window shifts m+1-n more times so object 1 reaches
+  * lane 0; both at once. Pipeline: comparator register, AND register.
+  */
+class StreamEngine(p: AccelParams) extends Engine(p) {
+  private val m = p.m
+  private val W = 6 * p.keyWidth
+
+  /** A box and, with the debug port, the object index it came from. */
+  class Entry extends Bundle {
+    val box = UInt(W.W)
+    val tag = UInt((if (p.debugPort) p.indexWidth else 0).W)
+  }
+  private def tagOf(index: UInt): UInt = if (p.debugPort) index else 0.U(0.W)
+
+  // ---- coordinate memory: one row of six keys per object ----
+  val mem = SyncReadMem(p.capacity, UInt(W.W))
+  when(io.write.valid) { mem.write(io.write.bits.index, io.write.bits.box.asUInt) }
+
+  // ---- run state ----
+  val n        = Reg(UInt(p.countWidth.W))
+  val starting = RegInit(false.B)
+  val issuing  = RegInit(false.B)
+  val fillLeft = Reg(UInt(p.countWidth.W))              // window shifts still needed at startup
+  val primeLeft = Reg(UInt(log2Ceil(p.readLatency + 1).W)) // cycles until the first read reaches the entry
+
+  val issue = issuing && io.advance
+  val fill  = starting && fillLeft =/= 0.U
+
+  // ---- read side: the stream R from R[m] on, read ahead into a small queue ----
+  // The memory and its output registers run freely (no enable, no
+  // multiplexer after the block RAM); reads are issued while the queue has
+  // room for them, and each issue takes one entry. Reading starts with the
+  // run, so the first object reaches the queue readLatency cycles later, and
+  // the reader then stays ahead: an issue always finds its object there.
+  val readQueue = Module(
+    new Queue(new Entry, p.readLatency + 2, flow = true, hasFlush = true)
+  )
+  val readsInFlight = Wire(UInt(log2Ceil(p.readLatency + 1).W))
+  val readEvent =
+    (starting || issuing) && readQueue.io.count +& readsInFlight < (p.readLatency + 2).U
+  val rObj       = Reg(UInt(p.indexWidth.W))  // object read at the next read event
+  val rLeft      = Reg(UInt(p.countWidth.W))  // objects after rObj in its block's stream
+  val rBlockLeft = Reg(UInt(p.countWidth.W))  // n-2-base of rObj's block
+  val rBase      = Reg(UInt(p.countWidth.W))
+  when(readEvent) {
+    when(rLeft =/= 0.U) {
+      rObj  := rObj + 1.U
+      rLeft := rLeft - 1.U
+    }.elsewhen(rBlockLeft >= m.U) {
+      // Next block's stream: objects base+m+1 .. n-1.
+      rBase      := rBase + m.U
+      rObj       := rBase + (m + 1).U
+      rLeft      := rBlockLeft - m.U
+      rBlockLeft := rBlockLeft - m.U
+    } // past the last block the stream is never compared: hold
+  }
+  val read = Wire(Valid(new Entry))
+  read.valid    := RegNext(readEvent, false.B)
+  read.bits.box := mem.read(rObj, readEvent)
+  read.bits.tag := RegNext(tagOf(rObj))
+  val readStages = Seq.iterate(read, p.memoryOutputStages + 1)(x => Pipe(x))
+  readsInFlight := PopCount(readStages.map(_.valid))
+  readQueue.io.enq.valid := readStages.last.valid
+  readQueue.io.enq.bits  := readStages.last.bits
+  readQueue.io.deq.ready := issue
+  readQueue.io.flush.get := io.launch.valid // drop what the last run read ahead
+  assert(!issue || readQueue.io.deq.valid, "the stream's reader fell behind the schedule")
+  assert(!readQueue.io.enq.valid || readQueue.io.enq.ready, "the stream's read queue overflowed")
+
+  // ---- the window: lane k holds object s+k ----
+  val window = Reg(Vec(m, new Entry))
+  val loadShift = io.write.valid && io.write.bits.index <= m.U // objects 0 .. m
+  val entry = Wire(new Entry)
+  entry.box := Mux(io.write.valid, io.write.bits.box.asUInt, readQueue.io.deq.bits.box)
+  entry.tag := Mux(io.write.valid, tagOf(io.write.bits.index), readQueue.io.deq.bits.tag)
+  when(loadShift || fill || issue) {
+    for (k <- 0 until m - 1) window(k) := window(k + 1)
+    window(m - 1) := entry
+  }
+
+  // ---- A blocks ----
+  val a     = Reg(Vec(m, new Entry))
+  val aNext = Reg(Vec(m, new Entry))
+  // Block 0: object k (< m) is in the top lane the cycle after it was loaded.
+  val loadedTop      = RegNext(io.write.valid && io.write.bits.index < m.U, false.B)
+  val loadedTopIndex = RegNext(io.write.bits.index)
+  // Later blocks: cycle k of a block finds object base+m+k in the top lane.
+  val capture = Reg(UInt(m.W)) // one-hot: lane of aNext to fill at this issue
+  for (k <- 0 until m) {
+    when((issue && capture(k)) || (loadedTop && loadedTopIndex === k.U)) { aNext(k) := window(m - 1) }
+  }
+
+  // ---- the schedule ----
+  val base      = Reg(UInt(p.countWidth.W))
+  val s         = Reg(UInt(p.countWidth.W))
+  val left      = Reg(UInt(p.countWidth.W)) // n-1-s: cycles after this one in the block
+  val blockLeft = Reg(UInt(p.countWidth.W)) // n-2-base
+  // The block-end test, computed one cycle ahead so that no comparison sits
+  // between the issue and the enables of the A registers.
+  val blockEnd     = Reg(Bool()) // left == 0
+  val hasNextBlock = Reg(Bool()) // blockLeft >= m
+  when(starting) {
+    for (k <- 0 until m) a(k) := aNext(k)
+    when(primeLeft =/= 0.U) { primeLeft := primeLeft - 1.U }
+    when(fillLeft =/= 0.U) { fillLeft := fillLeft - 1.U }
+    when(primeLeft <= 1.U && fillLeft <= 1.U) {
+      starting := false.B
+      issuing  := true.B
+    }
+  }
+  when(issue) {
+    when(!blockEnd) {
+      s        := s + 1.U
+      left     := left - 1.U
+      blockEnd := left === 1.U
+      capture  := (capture << 1)(m - 1, 0)
+    }.elsewhen(hasNextBlock) {
+      base         := base + m.U
+      s            := base + (m + 1).U
+      left         := blockLeft - m.U
+      blockLeft    := blockLeft - m.U
+      blockEnd     := blockLeft === m.U
+      hasNextBlock := blockLeft >= (2 * m).U
+      capture      := 1.U
+      for (k <- 0 until m) a(k) := aNext(k)
+    }.otherwise {
+      issuing := false.B
+    }
+  }
+  when(io.launch.valid) {
+    val count = io.launch.bits // >= 2
+    n         := count
+    starting  := true.B
+    primeLeft := p.readLatency.U
+    fillLeft  := Mux(count <= m.U, (m + 1).U - count, 0.U)
+    base      := 0.U
+    s         := 1.U
+    left      := count - 2.U
+    blockLeft := count - 2.U
+    blockEnd     := count === 2.U
+    hasNextBlock := count >= (m + 2).U
+    capture   := 1.U
+    rBase      := 0.U
+    rBlockLeft := count - 2.U
+    // R[m] is block 0's object m+1 when it exists; otherwise no later block
+    // exists and the stream past block 0 is never compared.
+    val longBlock = count >= (m + 2).U
+    rObj  := Mux(longBlock, (m + 1).U, 0.U)
+    rLeft := Mux(longBlock, count - (m + 2).U, 0.U)
+  }
+
+  // ---- comparators: registered compare, then registered AND ----
+  val remaining = n - s // >= 1 while issuing
+  class Meta extends Bundle {
+    val iBase    = UInt(p.indexWidth.W)
+    val jBase    = UInt(p.indexWidth.W)
+    val laneMask = UInt(m.W)
+    val probeI   = Vec(m, UInt(p.indexWidth.W)) // only with the debug port
+    val probeJ   = Vec(m, UInt(p.indexWidth.W))
+  }
+  val meta = Wire(new Meta)
+  meta.iBase    := base
+  meta.jBase    := s
+  meta.laneMask := VecInit(Seq.tabulate(m)(k => remaining > k.U)).asUInt
+  if (p.debugPort) {
+    // The objects each lane really holds, from the tags that travelled with the data.
+    meta.probeI := VecInit(a.map(_.tag))
+    meta.probeJ := VecInit(window.map(_.tag))
+  } else {
+    meta.probeI := DontCare
+    meta.probeJ := DontCare
+  }
+  private def boxOf(e: Entry): Aabb = e.box.asTypeOf(new Aabb(p.keyWidth))
+  // Six comparator results per lane, registered before the AND.
+  val compared = RegNext(VecInit(a.zip(window).map { case (ea, eb) =>
+    val (x, y) = (boxOf(ea), boxOf(eb))
+    VecInit((0 until 3).flatMap(axis => Seq(x.min(axis) <= y.max(axis), x.max(axis) >= y.min(axis)))).asUInt
+  }))
+  val atCompare = Pipe(issue, meta)
+  val hitMask   = RegNext(VecInit(compared.map(_.andR)).asUInt & atCompare.bits.laneMask)
+  val atAnd     = Pipe(atCompare)
+  require(p.pipelineLatency == 2)
+
+  io.activity.active   := starting || issuing
+  io.activity.issued   := issue
+  io.activity.stalled  := issuing && !io.advance
+  io.activity.inFlight := atCompare.valid.asUInt +& atAnd.valid.asUInt
+
+  emit(atAnd.valid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, atAnd.bits.probeI, atAnd.bits.probeJ, hitMask)
+}

@@ -1,0 +1,75 @@
+package bpaccel
+
+/** Golden model of the stream architecture's schedule, written from its
+  * description rather than from the hardware: it moves object numbers
+  * through an m-lane shift register (the B window) and m A registers, the
+  * way the description says the boxes move, and reads off which objects meet
+  * in each lane. It knows nothing of window starts, lane masks or formulas:
+  * a lane is compared when its B object belongs to the block being run.
+  *
+  *  - Loading shifts objects 0 .. m into the window's top lane; object k < m
+  *    is copied from the top lane into A register k the cycle after.
+  *  - After the start the window shifts (taking nothing useful) until object 1
+  *    is in lane 0, while the first reads travel to the window's entry.
+  *  - The memory is read in block order: block b's B objects b*m+1 .. n-1,
+  *    then block b+1's. Each issue shifts the window by one lane, the next
+  *    object of that order entering the top lane.
+  *  - In cycle d < m of a block, the top lane's object is copied into the
+  *    next block's A register d. A block ends when lane 0 holds its last
+  *    object; the next block's A registers then become the current ones.
+  */
+object StreamScheduleModel {
+  type Lane = Option[(Int, Int)]
+
+  /** An object in a register, with the block whose B stream it belongs to (-1: none). */
+  private case class Item(obj: Int, block: Int)
+  private val Garbage = Item(-1, -1)
+
+  case class Run(cycles: Vector[Vector[Lane]], startupCycles: Int)
+
+  def run(n: Int, m: Int, readLatency: Int): Run = {
+    require(m >= 1 && readLatency >= 1)
+    if (n < 2) return Run(Vector.empty, 0)
+    val blocks = (n - 2) / m + 1
+    val stream = (0 until blocks).flatMap(b => (b * m + 1 until n).map(Item(_, b)))
+
+    val window = Array.fill(m)(Garbage)
+    def shiftIn(item: Item): Unit = {
+      for (k <- 0 until m - 1) window(k) = window(k + 1)
+      window(m - 1) = item
+    }
+    val aNext = Array.fill(m)(-1)
+    // Loading: objects 0 .. m enter the window; the loaded ones are block 0's stream from object 1.
+    for (j <- 0 until n if j <= m) {
+      shiftIn(if (j == 0) Garbage else Item(j, 0))
+      if (j < m) aNext(j) = j // "copied from the top lane": it is object j
+    }
+    // Startup: shift until object 1 is in lane 0.
+    var fill = 0
+    while (window(0) != Item(1, 0)) { shiftIn(Garbage); fill += 1 }
+    val startup = math.max(fill, readLatency)
+
+    val out   = Vector.newBuilder[Vector[Lane]]
+    var a     = aNext.clone()
+    var block = 0
+    var d     = 0
+    var next  = m // the window holds stream(0 .. m-1); stream(m) enters next
+    while (block < blocks) {
+      out += Vector.tabulate(m) { k =>
+        val b = window(k)
+        if (b.block == block) Some((a(k), b.obj)) else None
+      }
+      if (d < m) aNext(d) = window(m - 1).obj
+      val blockEnds = window(0).block == block && (window(0).obj == n - 1)
+      shiftIn(if (next < stream.length) stream(next) else Garbage)
+      next += 1
+      d += 1
+      if (blockEnds) { block += 1; a = aNext.clone(); d = 0 }
+    }
+    Run(out.result(), startup)
+  }
+
+  def cycles(n: Int, m: Int, readLatency: Int): Vector[Vector[Lane]] = run(n, m, readLatency).cycles
+
+  def testedPairs(n: Int, m: Int, readLatency: Int): Seq[(Int, Int)] = cycles(n, m, readLatency).flatMap(_.flatten)
+}
