@@ -51,6 +51,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   control.io.overflow := loader.io.overflow
 
   engine.io.write   := loader.io.write
+  engine.io.clear   := io.start.fire
   engine.io.launch  := control.io.launch
   // Credits, registered so that no adder sits before the engine's enables:
   // queue count + cycles in flight grows by at most one a cycle, so room for

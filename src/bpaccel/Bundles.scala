@@ -77,6 +77,7 @@ class AccelInfo extends Bundle {
 /** The ports every architecture's engine offers the shared top level. */
 class EngineIO(p: AccelParams) extends Bundle {
   val write    = Flipped(Valid(new LoadWrite(p)))
+  val clear    = Input(Bool())                        // a start was accepted: the next box is object 0
   val launch   = Flipped(Valid(UInt(p.countWidth.W))) // a run of n >= 2 objects, all loaded
   val advance  = Input(Bool())                        // the result queue has room for one more issue
   val activity = Output(new EngineActivity(p))

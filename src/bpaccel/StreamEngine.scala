@@ -50,8 +50,10 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val fillLeft = Reg(UInt(p.countWidth.W))              // window shifts still needed at startup
   val primeLeft = Reg(UInt(log2Ceil(p.readLatency + 1).W)) // cycles until the first read reaches the entry
 
-  val issue = issuing && io.advance
-  val fill  = starting && fillLeft =/= 0.U
+  // Registered flags only in front of the window's enables (192m flip-flops).
+  val filling = RegInit(false.B) // starting && fillLeft != 0
+  val issue   = issuing && io.advance
+  val fill    = filling
 
   // ---- read side: the stream R from R[m] on, read ahead into a small queue ----
   // The memory and its output registers run freely (no enable, no
@@ -96,7 +98,11 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   // ---- the window: lane k holds object s+k ----
   val window = Reg(Vec(m, new Entry))
-  val loadShift = io.write.valid && io.write.bits.index <= m.U // objects 0 .. m
+  // Objects 0 .. m shift in as they are loaded; the flag says the next box is one of them.
+  val takesLoads = RegInit(true.B)
+  when(io.write.valid) { takesLoads := io.write.bits.index < m.U }
+  when(io.clear) { takesLoads := true.B } // a start: the next box is object 0
+  val loadShift = io.write.valid && takesLoads
   val entry = Wire(new Entry)
   entry.box := Mux(io.write.valid, io.write.bits.box.asUInt, readQueue.io.deq.bits.box)
   entry.tag := Mux(io.write.valid, tagOf(io.write.bits.index), readQueue.io.deq.bits.tag)
@@ -130,6 +136,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     for (k <- 0 until m) a(k) := aNext(k)
     when(primeLeft =/= 0.U) { primeLeft := primeLeft - 1.U }
     when(fillLeft =/= 0.U) { fillLeft := fillLeft - 1.U }
+    filling := fillLeft > 1.U
     when(primeLeft <= 1.U && fillLeft <= 1.U) {
       starting := false.B
       issuing  := true.B
@@ -160,6 +167,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     starting  := true.B
     primeLeft := p.readLatency.U
     fillLeft  := Mux(count <= m.U, (m + 1).U - count, 0.U)
+    filling   := count <= m.U
     base      := 0.U
     s         := 1.U
     left      := count - 2.U
