@@ -33,12 +33,12 @@ std::vector<Aabb> parse(const std::string& text) {
 }
 
 void checkBoxes(const std::vector<Aabb>& boxes, std::size_t lines) {
-  require(boxes.size() <= lines, fmt::format("{} boxes from {} lines", boxes.size(), lines));
+  require(boxes.size() <= lines, "{} boxes from {} lines", boxes.size(), lines);
   for (std::size_t i = 0; i < boxes.size(); ++i)
     for (int a = 0; a < 3; ++a) {
       const float lo = boxes[i].min[a], hi = boxes[i].max[a];
-      require(!std::isnan(lo) && !std::isnan(hi), fmt::format("box {} axis {} holds NaN", i, a));
-      require(lo <= hi, fmt::format("box {} axis {}: min {} > max {}", i, a, lo, hi));
+      require(!std::isnan(lo) && !std::isnan(hi), "box {} axis {} holds NaN", i, a);
+      require(lo <= hi, "box {} axis {}: min {} > max {}", i, a, lo, hi);
     }
 }
 
@@ -53,14 +53,14 @@ void checkRoundTrip(const std::vector<Aabb>& boxes) {
   try {
     again = parse(text);
   } catch (const ParseError& e) {
-    require(false, fmt::format("printed boxes do not read back: {}", e.what()));
+    require(false, "printed boxes do not read back: {}", e.what());
   }
   require(again.size() == boxes.size(), "round trip changed the box count");
   for (std::size_t i = 0; i < boxes.size(); ++i)
     for (int a = 0; a < 3; ++a)
       require(std::bit_cast<std::uint32_t>(again[i].min[a]) == std::bit_cast<std::uint32_t>(boxes[i].min[a]) &&
                   std::bit_cast<std::uint32_t>(again[i].max[a]) == std::bit_cast<std::uint32_t>(boxes[i].max[a]),
-              fmt::format("box {} axis {} changed in the round trip", i, a));
+              "box {} axis {} changed in the round trip", i, a);
 }
 
 // The first `count` lines of `text`, each with its line end.
@@ -77,22 +77,22 @@ std::string firstLines(const std::string& text, std::size_t count) {
 // the text up to and including it fails with the same message.
 void checkErrorLine(const std::string& text, std::size_t lines, const ParseError& error) {
   const std::size_t line = error.line();
-  require(line >= 1 && line <= lines, fmt::format("error on line {} of {}: {}", line, lines, error.what()));
+  require(line >= 1 && line <= lines, "error on line {} of {}: {}", line, lines, error.what());
   require(std::string_view(error.what()).starts_with(fmt::format("line {}: ", line)),
-          fmt::format("message does not start with its line: {}", error.what()));
+          "message does not start with its line: {}", error.what());
   try {
     checkBoxes(parse(firstLines(text, line - 1)), line - 1);
   } catch (const ParseError& before) {
-    require(false, fmt::format("error reported on line {} but line {} is bad already", line, before.line()));
+    require(false, "error reported on line {} but line {} is bad already", line, before.line());
   }
   try {
     parse(firstLines(text, line));
   } catch (const ParseError& same) {
     require(std::string_view(same.what()) == error.what(),
-            fmt::format("line {} alone fails differently: '{}' vs '{}'", line, same.what(), error.what()));
+            "line {} alone fails differently: '{}' vs '{}'", line, same.what(), error.what());
     return;
   }
-  require(false, fmt::format("error reported on line {}, but the text up to it reads cleanly", line));
+  require(false, "error reported on line {}, but the text up to it reads cleanly", line);
 }
 
 }  // namespace

@@ -142,16 +142,16 @@ void checkExact(const Setup& setup, const std::vector<Aabb>& boxes, const Expect
   const std::size_t n = boxes.size();
   std::vector<std::uint8_t> seen(n * n);
   for (const auto& [i, j] : pairs) {
-    require(i < j && j < n, fmt::format("{}: bad pair ({}, {})", setup.label, i, j));
-    require(expected.contains(i, j), fmt::format("{}: ({}, {}) do not overlap", setup.label, i, j));
-    require(!seen[i * n + j], fmt::format("{}: ({}, {}) reported twice", setup.label, i, j));
+    require(i < j && j < n, "{}: bad pair ({}, {})", setup.label, i, j);
+    require(expected.contains(i, j), "{}: ({}, {}) do not overlap", setup.label, i, j);
+    require(!seen[i * n + j], "{}: ({}, {}) reported twice", setup.label, i, j);
     seen[i * n + j] = 1;
   }
   if (pairs.size() == expected.count()) return;  // every reported pair expected, none twice: all found
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = i + 1; j < n; ++j)
       require(!expected.contains(i, j) || seen[i * n + j],
-              fmt::format("{} on {} boxes: missing ({}, {})", setup.label, n, i, j));
+              "{} on {} boxes: missing ({}, {})", setup.label, n, i, j);
 }
 
 void checkRefused(const Setup& setup, const std::vector<Aabb>& boxes, std::size_t badBox) {
@@ -160,10 +160,10 @@ void checkRefused(const Setup& setup, const std::vector<Aabb>& boxes, std::size_
   try {
     broadPhase->findPairs(boxes, pairs);
   } catch (const InputError& e) {
-    require(e.object() == badBox, fmt::format("{}: NaN in box {} reported as {}", setup.label, badBox, e.what()));
+    require(e.object() == badBox, "{}: NaN in box {} reported as {}", setup.label, badBox, e.what());
     return;
   }
-  require(false, fmt::format("{}: NaN in box {} accepted", setup.label, badBox));
+  require(false, "{}: NaN in box {} accepted", setup.label, badBox);
 }
 
 // The key map's contract on the scene's own values: float order is key order.
@@ -177,7 +177,7 @@ void checkKeyOrder(const std::vector<Aabb>& boxes) {
     const float x = values[t - 1], y = values[t];
     const std::uint32_t kx = floatToKey(x), ky = floatToKey(y);
     require((x < y) == (kx < ky) && (x == y) == (kx == ky),
-            fmt::format("keys {:#x} {:#x} misorder {} {}", kx, ky, x, y));
+            "keys {:#x} {:#x} misorder {} {}", kx, ky, x, y);
   }
 }
 
