@@ -218,6 +218,13 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
     const auto t0 = Clock::now();
     e.method = e.spec->make(start);
     e.setupSeconds = since(t0);
+    if (e.setupSeconds > config_.maxMethodSeconds) {
+      e.skipped = fmt::format("its set-up took {:.0f} s, above the limit of {:.0f} s (--max-method-seconds)",
+                              e.setupSeconds, config_.maxMethodSeconds);
+      e.method.reset();
+      progress_(fmt::format("n={} {}: stopped: {}", objects, e.spec->name, *e.skipped));
+      continue;
+    }
     active.push_back(k);
   }
 
@@ -240,6 +247,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
     exactSeconds += since(t);
     if (timed) exactTotal += exact.size();
     // A new order every frame: no method always follows the one that empties the caches.
+    std::erase_if(order, [&](std::size_t k) { return entries[k].skipped.has_value(); });
     std::shuffle(order.begin(), order.end(), shuffler);
     for (std::size_t k : order) {
       Entry& e = entries[k];
@@ -262,6 +270,13 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
       e.duplicates += duplicates;
       if (mustBeExact(e.spec->kind) && (d.missing || d.extra || duplicates))
         throw ValidationFailure(e.spec->name, objects, frame, d, exact.size());
+      if (wall > config_.maxMethodSeconds) {
+        e.skipped = fmt::format("stopped at frame {}: one update took {:.0f} s, above the limit of {:.0f} s "
+                                "(--max-method-seconds); that frame was validated",
+                                frame + 1, wall, config_.maxMethodSeconds);
+        progress_(fmt::format("n={} {}: {}", objects, e.spec->name, *e.skipped));
+        continue;
+      }
       if (!timed) continue;
       e.frameSeconds.push_back(ft.seconds);
       if (const auto& p = ft.parts) {
@@ -289,6 +304,8 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
       e.method.reset();
       teardown[e.spec->name] = since(t0);
     }
+  for (Entry& e : entries)
+    if (e.skipped) e.frameSeconds.clear();  // a stopped method's frames are not reported
 
   nlohmann::json row;
   row["objects"] = objects;

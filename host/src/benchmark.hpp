@@ -23,6 +23,9 @@ struct BenchConfig {
   std::size_t frames = 50;  // timed frames per row
   std::size_t warmup = 5;   // frames simulated and run but not timed
   SceneConfig scene;        // objects is set per row
+  /// A method whose set-up or one frame's update takes longer is stopped for
+  /// the rest of the row and listed as skipped with the time it took.
+  double maxMethodSeconds = 60;
 };
 
 /// What the standard line-up holds.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -382,4 +383,32 @@ TEST(BenchCli, NamesTheLinkUnitAndListsSkippedMethodsInTableAndJson) {
   for (const auto& m : j["rows"][0]["methods"]) skipped += m.contains("skipped");
   EXPECT_EQ(skipped, 3u);  // btSimpleBroadphase, accelerator and cpu without the tree
   std::filesystem::remove(json);
+}
+
+TEST(Benchmark, AMethodSlowerThanTheLimitIsStoppedAndListedWithItsTime) {
+  LineUpConfig l;
+  MethodSpec slow = fakePeer(0, 1e-3, false);
+  slow.name = "slow";
+  slow.make = [](const SceneStart&) {
+    struct Slow final : TimedMethod {
+      void update(std::span<const Aabb> boxes) override {
+        sortAndSweepPairs(boxes, pairs_);
+        const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(30);
+        while (std::chrono::steady_clock::now() < until) {
+        }
+      }
+      void pairs(std::vector<Pair>& out) override { out = pairs_; }
+      std::vector<Pair> pairs_;
+    };
+    return std::make_unique<Slow>();
+  };
+  auto config = tinyConfig();
+  config.maxMethodSeconds = 0.01;
+  const auto j = runQuietly(config, {fakePeer(1, 1e-3, false), slow}, l);
+  for (const auto& row : j["rows"]) {
+    EXPECT_FALSE(row["methods"][0].contains("skipped"));
+    ASSERT_TRUE(row["methods"][1].contains("skipped"));
+    EXPECT_NE(row["methods"][1]["skipped"].get<std::string>().find("stopped at frame 1"), std::string::npos);
+    EXPECT_TRUE(row["methods"][1]["frame_ms"].is_null());
+  }
 }
