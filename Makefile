@@ -67,6 +67,17 @@ bench: host
 	build/bin/bpaccel scene --objects 100 --frames 30 --out results/scene.json
 	$(PYTHON) scripts/render_scene.py --json results/scene.json --out results/scene.png
 
+# The seed's sizes, 100,000 and 1,000,000 objects: device cycles from the
+# cycle-exact model backend (the Verilated one would take hours), every frame
+# of every method still validated, a few frames a row. The 100,000 row took
+# 13 min on a loaded 2-core machine (9 of them bt32BitAxisSweep3's O(n^2)
+# set-up); --max-method-seconds bounds the slowest methods of the 1,000,000 row.
+BENCH_LARGE_ARGS ?= --objects 100000 1000000 --backend model --frames 3 --warmup 1
+.PHONY: bench-large
+bench-large: host
+	mkdir -p results/large; set -o pipefail; build/bin/bpaccel bench --json results/large/bench.json $(BENCH_LARGE_ARGS) | tee results/large/bench.txt
+	$(PYTHON) scripts/plot_bench.py --json results/large/bench.json --out-dir results/large
+
 # FPGA flow (docs/fpga.md): ECP5 synthesis, place and route with a measured
 # The same host, Verilated model and tests under AddressSanitizer and
 # UndefinedBehaviorSanitizer (host/cmake/sanitize.cmake); any report fails.
