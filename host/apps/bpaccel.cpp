@@ -29,7 +29,7 @@ namespace {
 std::unique_ptr<bpaccel::Backend> makeBackend(const std::string& name) {
   if (name == "rtl") return std::make_unique<bpaccel::RtlBackend>();
   if (name == "model")
-    return std::make_unique<bpaccel::ModelBackend>(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+    return std::make_unique<bpaccel::ModelBackend>(bpaccel::modelOfBuiltHardware());  // this build's architecture
   return std::make_unique<bpaccel::CpuBackend>();
 }
 

@@ -338,7 +338,7 @@ TEST(LinkModel, ALinkFasterThanTheLoadPortAddsNothingForBoxes) {
 
 TEST(AcceleratorMethod, DeviceTimeCountsLoadCycles) {
   auto d = std::make_shared<DeviceConfig>();
-  d->makeBackend = [] { return std::make_unique<ModelBackend>(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES); };
+  d->makeBackend = [] { return std::make_unique<ModelBackend>(modelOfBuiltHardware()); };
   d->clockHz = 100e6;
   AcceleratorMethod method(d, 16);
   const auto boxes = bpaccel::testing::adversarialScenes(200, 1)[0].second;
