@@ -8,6 +8,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <thread>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -194,7 +195,9 @@ int main(int argc, char** argv) {
   pairs->add_flag("--stats", stats, "Print cycles and timings to stderr");
 
   bpaccel::BenchConfig bench;
+  bench.wholeStepObjects = 8000;
   bpaccel::LineUpConfig lineUp;
+  lineUp.cpuThreads = std::thread::hardware_concurrency();
   std::vector<std::string> benchCells = {"none", "16", "32", "64", "128", "256"};
   std::string benchBackend = "rtl", benchJson = "results/bench.json";
   double clockMHz = 0, linkGBytesPerSecond = 4, linkLatencyUs = 1;
@@ -224,6 +227,13 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)->capture_default_str();
   benchCmd->add_option("--link-latency-us", linkLatencyUs, "Modelled latency per accelerator run, microseconds")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  benchCmd->add_option("--whole-step-objects", bench.wholeStepObjects,
+                       "Also time full stepSimulation calls with btDbvtBroadphase and bpaccel::Broadphase at this "
+                       "object count (0: not)")
+      ->capture_default_str();
+  benchCmd->add_option("--cpu-threads", lineUp.cpuThreads,
+                       "Threads of the extra 'cpu k-d C, T threads' rows (default: every hardware thread; 0 or 1: none)")
+      ->capture_default_str();
   benchCmd->add_option("--max-all-pairs-tests", lineUp.maxAllPairsTests,
                        "Skip methods that test all pairs (btSimpleBroadphase, k-d none) where n(n-1)/2 exceeds this")
       ->check(CLI::PositiveNumber)->capture_default_str();

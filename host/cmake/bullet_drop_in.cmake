@@ -45,6 +45,7 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/bpaccel.pc DESTINATION ${CMAKE_INSTALL
 
 # Whole-step timing for the benchmark (bouncing cube with any broad phase).
 target_sources(bpaccel_bench PRIVATE ${_bpaccel_src}/step_timing.cpp)
+target_link_libraries(bpaccel_bench PUBLIC bpaccel_bullet)
 
 target_sources(host_tests PRIVATE ${CMAKE_CURRENT_LIST_DIR}/../tests/drop_in_test.cpp)
 target_link_libraries(host_tests PRIVATE bpaccel_bullet)

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 namespace bpaccel {
 
 double LinkModel::seconds(const RunStats& s, std::size_t bytesPerBeat, double clockHz) const {
@@ -58,6 +60,21 @@ std::vector<MethodSpec> acceleratorMethods(std::shared_ptr<const DeviceConfig> d
   if (!(device->clockHz > 0)) throw std::invalid_argument("bench: clock must be positive");
   return perCellSize("accelerator", MethodKind::Accelerator, cellSizes, maxAllPairsTests,
                      [device](std::optional<std::size_t> c) { return std::make_unique<AcceleratorMethod>(device, c); });
+}
+
+std::vector<MethodSpec> threadedCpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, std::size_t threads) {
+  std::vector<MethodSpec> specs;
+  for (const auto& c : cellSizes) {
+    if (!c) continue;  // one cell: nothing to share out
+    MethodSpec s;
+    s.name = fmt::format("cpu k-d {}, {} threads", *c, threads);
+    s.kind = MethodKind::Cpu;
+    s.library = "bpaccel";
+    s.cellSize = c;
+    s.make = [c, threads](const SceneStart&) { return std::make_unique<ThreadedCpuMethod>(c, threads); };
+    specs.push_back(std::move(s));
+  }
+  return specs;
 }
 
 std::vector<MethodSpec> cpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, double maxAllPairsTests) {

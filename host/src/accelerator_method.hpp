@@ -72,12 +72,27 @@ class CpuMethod final : public TimedMethod {
   std::vector<Pair> pairs_;
 };
 
+/// The same on several threads: the tree is built on one, its cells shared out.
+class ThreadedCpuMethod final : public TimedMethod {
+ public:
+  ThreadedCpuMethod(std::optional<std::size_t> cellSize, std::size_t threads)
+      : phase_([] { return std::make_unique<CpuBackend>(); }, cellSize, threads) {}
+  void update(std::span<const Aabb> boxes) override { phase_.findPairs(boxes, pairs_); }
+  void pairs(std::vector<Pair>& out) override { out = pairs_; }
+
+ private:
+  BroadPhase phase_;
+  std::vector<Pair> pairs_;
+};
+
 /// "accelerator k-d C" per cell size (none = no tree, all pairs: skipped above `maxAllPairsTests`).
 std::vector<MethodSpec> acceleratorMethods(std::shared_ptr<const DeviceConfig> device,
                                            const std::vector<std::optional<std::size_t>>& cellSizes,
                                            double maxAllPairsTests);
 /// "cpu k-d C" per cell size, with the same skip rule.
 std::vector<MethodSpec> cpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, double maxAllPairsTests);
+/// "cpu k-d C, T threads" per cell size with a tree.
+std::vector<MethodSpec> threadedCpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, std::size_t threads);
 
 std::string cellName(const std::optional<std::size_t>& cellSize);
 

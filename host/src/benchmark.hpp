@@ -26,6 +26,11 @@ struct BenchConfig {
   /// A method whose set-up or one frame's update takes longer is stopped for
   /// the rest of the row and listed as skipped with the time it took.
   double maxMethodSeconds = 60;
+  /// Whole-step comparison (full stepSimulation of the world with Bullet's
+  /// btDbvtBroadphase and with bpaccel::Broadphase on the cpu backend) at
+  /// this object count; 0: none.
+  std::size_t wholeStepObjects = 0;
+  std::size_t wholeStepFrames = 20;
 };
 
 /// What the standard line-up holds.
@@ -34,6 +39,8 @@ struct LineUpConfig {
   /// Methods that test all n(n-1)/2 pairs a frame are skipped above this.
   double maxAllPairsTests = 1e8;
   std::shared_ptr<const DeviceConfig> device;  // the accelerator's; none: no accelerator methods
+  /// Above 1: the cpu backend also runs on this many threads, per cell size with a tree.
+  std::size_t cpuThreads = 0;
 };
 
 /// Bullet's three broad phases, the peers (FCL, CGAL, ODE), then the
@@ -55,6 +62,7 @@ class Benchmark {
 
  private:
   nlohmann::json runRow(std::size_t objects);
+  nlohmann::json wholeSteps();
   BenchConfig config_;
   std::vector<MethodSpec> lineUp_;
   nlohmann::json configuration_;

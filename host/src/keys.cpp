@@ -45,8 +45,11 @@ namespace {
 bool isBad(const Aabb& b, const KeyBox& k) {
   bool nan = false;
   for (int a = 0; a < 3; ++a)
-    nan |= isNaNBits(std::bit_cast<std::uint32_t>(b.min[a])) | isNaNBits(std::bit_cast<std::uint32_t>(b.max[a]));
-  return nan | (k.min[0] > k.max[0]) | (k.min[1] > k.max[1]) | (k.min[2] > k.max[2]);
+    nan |= static_cast<int>(isNaNBits(std::bit_cast<std::uint32_t>(b.min[a]))) |
+           static_cast<int>(isNaNBits(std::bit_cast<std::uint32_t>(b.max[a])));
+  // int, not bool, operands: all six compares, branch-free (and no -Wbitwise-instead-of-logical).
+  return nan | static_cast<int>(k.min[0] > k.max[0]) | static_cast<int>(k.min[1] > k.max[1]) |
+         static_cast<int>(k.min[2] > k.max[2]);
 }
 
 [[noreturn]] void throwFirstBad(std::span<const Aabb> boxes, const std::vector<KeyBox>& keys) {

@@ -412,3 +412,18 @@ TEST(Benchmark, AMethodSlowerThanTheLimitIsStoppedAndListedWithItsTime) {
     EXPECT_TRUE(row["methods"][1]["frame_ms"].is_null());
   }
 }
+
+TEST(Benchmark, TheCpuBackendAlsoRunsOnSeveralThreadsExactly) {
+  auto l = tinyLineUp();
+  l.cpuThreads = 2;
+  const auto j = runQuietly(tinyConfig(), standardLineUp(l), l);
+  std::size_t threaded = 0;
+  for (const auto& m : j["rows"][0]["methods"])
+    if (m["name"].get<std::string>().find(", 2 threads") != std::string::npos) {
+      ++threaded;
+      EXPECT_EQ(m["kind"], "cpu");
+      EXPECT_EQ(m["missing_pairs"], 0);
+      EXPECT_EQ(m["extra_pairs"], 0);
+    }
+  EXPECT_EQ(threaded, 2u);  // cell sizes 4 and 16; none has one cell to share
+}
