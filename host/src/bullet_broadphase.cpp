@@ -65,11 +65,16 @@ BulletBroadphase::BulletBroadphase(Kind kind, std::span<const Aabb> initial, flo
   broadphase_->calculateOverlappingPairs(dispatcher_.get());
 }
 
-// The broad phase frees its proxies and pair cache itself. Destroying the
-// proxies one by one first would cost the sweep O(n^2) (each removal moves
-// its edges to the end of every axis), and no pair holds a collision
-// algorithm to free: nothing was dispatched.
-BulletBroadphase::~BulletBroadphase() = default;
+// btDbvtBroadphase allocates every proxy and frees it only in destroyProxy
+// (LeakSanitizer reports the rest), so its proxies are destroyed first. The
+// sweep (built without a raycast accelerator) and the simple broad phase keep
+// their proxies in arrays they free themselves; destroying them one by one
+// would cost the sweep O(n^2) (each removal moves its edges to the end of
+// every axis). No pair holds a collision algorithm: nothing was dispatched.
+BulletBroadphase::~BulletBroadphase() {
+  if (kind_ == Kind::Dbvt)
+    for (btBroadphaseProxy* p : proxies_) broadphase_->destroyProxy(p, dispatcher_.get());
+}
 
 void BulletBroadphase::update(std::span<const Aabb> boxes) {
   if (boxes.size() != proxies_.size()) throw std::invalid_argument("bullet broadphase: object count changed");
