@@ -71,7 +71,7 @@ std::vector<MethodSpec> threadedCpuMethods(const std::vector<std::optional<std::
     s.kind = MethodKind::Cpu;
     s.library = "bpaccel";
     s.cellSize = c;
-    s.make = [c, threads](const SceneStart&) { return std::make_unique<ThreadedCpuMethod>(c, threads); };
+    s.make = [c, threads](const SceneStart&) { return std::make_unique<CpuMethod>(c, threads); };
     specs.push_back(std::move(s));
   }
   return specs;

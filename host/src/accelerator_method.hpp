@@ -59,23 +59,11 @@ class AcceleratorMethod final : public TimedMethod {
   std::vector<Pair> pairs_;
 };
 
-/// BroadPhase on the cpu backend: software alone, all measured.
+/// BroadPhase on the cpu backend: software alone, all measured. With several
+/// threads the tree is built on one and its cells shared out among them.
 class CpuMethod final : public TimedMethod {
  public:
-  explicit CpuMethod(std::optional<std::size_t> cellSize) : phase_(backend_, cellSize) {}
-  void update(std::span<const Aabb> boxes) override { phase_.findPairs(boxes, pairs_); }
-  void pairs(std::vector<Pair>& out) override { out = pairs_; }
-
- private:
-  CpuBackend backend_;
-  BroadPhase phase_;
-  std::vector<Pair> pairs_;
-};
-
-/// The same on several threads: the tree is built on one, its cells shared out.
-class ThreadedCpuMethod final : public TimedMethod {
- public:
-  ThreadedCpuMethod(std::optional<std::size_t> cellSize, std::size_t threads)
+  explicit CpuMethod(std::optional<std::size_t> cellSize, std::size_t threads = 1)
       : phase_([] { return std::make_unique<CpuBackend>(); }, cellSize, threads) {}
   void update(std::span<const Aabb> boxes) override { phase_.findPairs(boxes, pairs_); }
   void pairs(std::vector<Pair>& out) override { out = pairs_; }
