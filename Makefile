@@ -78,7 +78,6 @@ bench-large: host
 	mkdir -p results/large; set -o pipefail; build/bin/bpaccel bench --json results/large/bench.json $(BENCH_LARGE_ARGS) | tee results/large/bench.txt
 	$(PYTHON) scripts/plot_bench.py --json results/large/bench.json --out-dir results/large
 
-# FPGA flow (docs/fpga.md): ECP5 synthesis, place and route with a measured
 # The same host, Verilated model and tests under AddressSanitizer and
 # UndefinedBehaviorSanitizer (host/cmake/sanitize.cmake); any report fails.
 HOST_SANITIZE_BUILD := build/host-asan-$(ARCH_PREFIX)m$(M)-c$(CAPACITY)
@@ -113,6 +112,7 @@ test-fuzz: fuzz
 fuzz-long: fuzz
 	nice host/fuzz/run.sh --runs $(FUZZ_BUILD) $(FUZZ_RUNS)
 
+# FPGA flow (docs/fpga.md): ECP5 synthesis, place and route with a measured
 # Fmax, and a Xilinx 7-series synthesis estimate.
 fpga: deps
 	$(MAKE) verilog ARCH=$(ARCH) M=$(M) CAPACITY=$(CAPACITY) KEY_WIDTH=$(KEY_WIDTH) VERILOG_DIR=build/fpga-verilog/$(ARCH_PREFIX)m$(M)

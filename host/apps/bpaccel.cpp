@@ -237,6 +237,10 @@ int main(int argc, char** argv) {
   benchCmd->add_option("--max-all-pairs-tests", lineUp.maxAllPairsTests,
                        "Skip methods that test all pairs (btSimpleBroadphase, k-d none) where n(n-1)/2 exceeds this")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  benchCmd->add_option("--max-sweep-tests", lineUp.maxSweepTests,
+                       "Skip sweeps that cannot be stopped midway (FCL SaP, rebuilt each frame) where more pairs "
+                       "than this overlap on x")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   benchCmd->add_option("--max-method-seconds", bench.maxMethodSeconds,
                        "Stop a method for the rest of a row when its set-up or one frame takes longer, seconds")
       ->check(CLI::PositiveNumber)->capture_default_str();

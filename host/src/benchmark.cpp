@@ -95,7 +95,7 @@ SetDifference compareSorted(const std::vector<Pair>& got, const std::vector<Pair
 
 std::vector<MethodSpec> standardLineUp(const LineUpConfig& config) {
   std::vector<MethodSpec> specs = bulletMethods(config.maxAllPairsTests);
-  for (auto&& group : {fclMethods(), cgalMethods(), odeMethods()})
+  for (auto&& group : {fclMethods(config.maxSweepTests), cgalMethods(), odeMethods()})
     for (auto& s : group) specs.push_back(s);
   if (config.device)
     for (auto& s : acceleratorMethods(config.device, config.cellSizes, config.maxAllPairsTests))
@@ -109,7 +109,8 @@ std::vector<MethodSpec> standardLineUp(const LineUpConfig& config) {
 nlohmann::json describe(const LineUpConfig& config) {
   nlohmann::json cells = nlohmann::json::array();
   for (const auto& c : config.cellSizes) cells.push_back(cellName(c));
-  nlohmann::json j = {{"cell_sizes", cells}, {"max_all_pairs_tests_per_frame", config.maxAllPairsTests}};
+  nlohmann::json j = {{"cell_sizes", cells}, {"max_all_pairs_tests_per_frame", config.maxAllPairsTests},
+                      {"max_sweep_tests", config.maxSweepTests}};
   if (const auto& d = config.device) {
     j["accelerator_backend"] = d->backend;
     j["hardware"] = d->hardware;
@@ -246,7 +247,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
   for (std::size_t k = 0; k < lineUp_.size(); ++k) {
     Entry& e = entries[k];
     e.spec = &lineUp_[k];
-    if (e.spec->skipReason) e.skipped = e.spec->skipReason(objects);
+    if (e.spec->skipReason) e.skipped = e.spec->skipReason(start);
     if (e.skipped) {
       progress_(fmt::format("n={} {}: skipped: {}", objects, e.spec->name, *e.skipped));
       continue;

@@ -38,6 +38,9 @@ struct LineUpConfig {
   std::vector<std::optional<std::size_t>> cellSizes{std::nullopt, 16, 32, 64, 128, 256};
   /// Methods that test all n(n-1)/2 pairs a frame are skipped above this.
   double maxAllPairsTests = 1e8;
+  /// A sweep along x that cannot be stopped midway (FCL's SaP, rebuilt every
+  /// frame) is skipped where more pairs than this overlap on x.
+  double maxSweepTests = 1e9;
   std::shared_ptr<const DeviceConfig> device;  // the accelerator's; none: no accelerator methods
   /// Above 1: the cpu backend also runs on this many threads, per cell size with a tree.
   std::size_t cpuThreads = 0;

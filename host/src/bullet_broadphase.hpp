@@ -46,7 +46,7 @@ class BulletBroadphase final : public TimedMethod {
 std::vector<MethodSpec> bulletMethods(double maxAllPairsTests);
 
 /// Why bt32BitAxisSweep3 cannot run at `objects`, if it cannot: Bullet inserts
-/// each proxy by insertion sort on every axis, so its set-up is O(n^2).
+/// each proxy by insertion sort on every axis, so its set-up is Theta(n^2).
 std::optional<std::string> axisSweepSkipReason(std::size_t objects);
 
 }  // namespace bpaccel

@@ -1,5 +1,8 @@
 #include "timed_method.hpp"
 
+#include <algorithm>
+#include <numeric>
+
 #include <fmt/format.h>
 
 namespace bpaccel {
@@ -16,12 +19,41 @@ std::string_view kindName(MethodKind kind) {
 
 bool mustBeExact(MethodKind kind) { return kind == MethodKind::Accelerator || kind == MethodKind::Cpu; }
 
-std::function<std::optional<std::string>(std::size_t)> allPairsSkipReason(double maxTestsPerFrame) {
-  return [maxTestsPerFrame](std::size_t objects) -> std::optional<std::string> {
+SkipRule allPairsSkipReason(double maxTestsPerFrame) {
+  return [maxTestsPerFrame](const SceneStart& start) -> std::optional<std::string> {
+    const std::size_t objects = start.boxes.size();
     const double tests = static_cast<double>(objects) * (static_cast<double>(objects) - 1) / 2;
     if (tests <= maxTestsPerFrame) return std::nullopt;
     return fmt::format("tests all pairs: {:.2g} tests a frame, above the limit of {:.2g} (--max-all-pairs-tests)",
                        tests, maxTestsPerFrame);
+  };
+}
+
+std::uint64_t pairsOverlappingOnX(std::span<const Aabb> boxes) {
+  std::vector<float> mins(boxes.size());
+  std::transform(boxes.begin(), boxes.end(), mins.begin(), [](const Aabb& b) { return b.min[0]; });
+  std::vector<std::uint32_t> byMin(boxes.size());
+  std::iota(byMin.begin(), byMin.end(), 0u);
+  std::sort(byMin.begin(), byMin.end(), [&](std::uint32_t a, std::uint32_t b) { return mins[a] < mins[b]; });
+  std::sort(mins.begin(), mins.end());
+  // Each pair once: counted at the box that comes first in order of min x,
+  // against every later box whose min x is not beyond its max x.
+  std::uint64_t pairs = 0;
+  for (std::size_t p = 0; p < mins.size(); ++p) {
+    const auto end = std::upper_bound(mins.begin() + static_cast<std::ptrdiff_t>(p) + 1, mins.end(),
+                                      boxes[byMin[p]].max[0]);
+    pairs += static_cast<std::uint64_t>(end - mins.begin()) - p - 1;
+  }
+  return pairs;
+}
+
+SkipRule sweepSkipReason(double maxTests) {
+  return [maxTests](const SceneStart& start) -> std::optional<std::string> {
+    const auto tests = static_cast<double>(pairsOverlappingOnX(start.boxes));
+    if (tests <= maxTests) return std::nullopt;
+    return fmt::format("its sweep along x tests every pair that overlaps on x, {:.2g} on this scene, and cannot be "
+                       "stopped midway: above the limit of {:.2g} (--max-sweep-tests)",
+                       tests, maxTests);
   };
 }
 

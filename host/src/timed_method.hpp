@@ -70,13 +70,23 @@ struct MethodSpec {
   MethodKind kind = MethodKind::Peer;
   std::string library;                  // e.g. "Bullet 3.24": the table's blocks per library
   std::optional<std::size_t> cellSize;  // accelerator and cpu: the k-d tree's cell size
-  /// Why the method cannot run at this object count; nullopt when it can. May be empty.
-  std::function<std::optional<std::string>(std::size_t objects)> skipReason;
+  /// Why the method cannot run on this scene; nullopt when it can. May be empty.
+  std::function<std::optional<std::string>(const SceneStart&)> skipReason;
   std::function<std::unique_ptr<TimedMethod>(const SceneStart&)> make;
 };
 
+using SkipRule = std::function<std::optional<std::string>(const SceneStart&)>;
+
 /// The skip rule of methods that test all n(n-1)/2 pairs every frame: they
 /// are skipped where that exceeds `maxTestsPerFrame`.
-std::function<std::optional<std::string>(std::size_t objects)> allPairsSkipReason(double maxTestsPerFrame);
+SkipRule allPairsSkipReason(double maxTestsPerFrame);
+
+/// The number of pairs of boxes whose x intervals overlap (closed): the
+/// interval tests of a sort-and-sweep along x. O(n log n).
+std::uint64_t pairsOverlappingOnX(std::span<const Aabb> boxes);
+
+/// The skip rule of a sort-and-sweep along x that cannot be interrupted (set-up
+/// or rebuild): skipped where the scene's pairsOverlappingOnX exceeds `maxTests`.
+SkipRule sweepSkipReason(double maxTests);
 
 }  // namespace bpaccel

@@ -278,11 +278,42 @@ TEST(Benchmark, SkippedMethodsAreListedWithTheirReason) {
   EXPECT_NE(table.find("n=60 btSimpleBroadphase: skipped: tests all pairs"), std::string::npos) << table;
 }
 
-TEST(Benchmark, TheAxisSweepIsSkippedWhereItsSetUpCannotFinish) {
-  EXPECT_FALSE(axisSweepSkipReason(100000).has_value());
-  const auto reason = axisSweepSkipReason(1000000);
+TEST(Benchmark, TheAxisSweepIsSkippedWhereItsSetUpTakesMinutes) {
+  EXPECT_FALSE(axisSweepSkipReason(50000).has_value());
+  for (std::size_t n : {50001u, 100000u, 1000000u}) {
+    const auto reason = axisSweepSkipReason(n);
+    ASSERT_TRUE(reason.has_value()) << n;
+    EXPECT_NE(reason->find("Theta(n^2)"), std::string::npos);
+  }
+}
+
+TEST(Benchmark, PairsOverlappingOnXCountsEveryClosedOverlapOnce) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> coord(0, 12);  // a coarse grid: many shared end points
+  for (int scene = 0; scene < 50; ++scene) {
+    std::vector<Aabb> boxes(static_cast<std::size_t>(scene));
+    for (Aabb& b : boxes) {
+      const int a = coord(rng), c = coord(rng);
+      b = Aabb{{float(std::min(a, c)), 0, 0}, {float(std::max(a, c)), 1, 1}};
+    }
+    std::uint64_t brute = 0;
+    for (std::size_t i = 0; i < boxes.size(); ++i)
+      for (std::size_t j = i + 1; j < boxes.size(); ++j)
+        brute += boxes[i].min[0] <= boxes[j].max[0] && boxes[j].min[0] <= boxes[i].max[0];
+    EXPECT_EQ(pairsOverlappingOnX(boxes), brute) << "scene " << scene;
+  }
+}
+
+TEST(Benchmark, ASweepIsSkippedWhereTooManyPairsOverlapOnX) {
+  // Ten boxes on one x interval (45 pairs) but apart on y: only the sweep's work is large.
+  std::vector<Aabb> boxes;
+  for (int i = 0; i < 10; ++i) boxes.push_back(Aabb{{0, float(3 * i), 0}, {1, float(3 * i + 1), 1}});
+  const SceneStart start{boxes, -1, 40};
+  EXPECT_FALSE(sweepSkipReason(45)(start).has_value());
+  const auto reason = sweepSkipReason(44)(start);
   ASSERT_TRUE(reason.has_value());
-  EXPECT_NE(reason->find("O(n^2)"), std::string::npos);
+  EXPECT_NE(reason->find("45 on this scene"), std::string::npos) << *reason;
+  EXPECT_NE(reason->find("--max-sweep-tests"), std::string::npos) << *reason;
 }
 
 TEST(Benchmark, MethodsRunInADifferentOrderEveryFrame) {

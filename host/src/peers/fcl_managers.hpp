@@ -28,6 +28,8 @@ class FclManager final : public TimedMethod {
   std::vector<Pair> pairs_;
 };
 
-std::vector<MethodSpec> fclMethods();
+/// FCL's three broad-phase managers. The SaP manager, rebuilt every frame, is
+/// skipped where more than `maxSweepTests` pairs overlap on x (sweepSkipReason).
+std::vector<MethodSpec> fclMethods(double maxSweepTests);
 
 }  // namespace bpaccel
