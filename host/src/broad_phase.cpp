@@ -99,7 +99,21 @@ void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out)
   stats_ = {};
   times_ = {};
   const auto t0 = Clock::now();
-  if (cellSize_) {
+  if (cellSize_ && !pool_) {
+    // One thread: each cell goes to the backend as soon as the tree has made
+    // it, so the first run is ready long before the tree is finished.
+    startCells(t0);
+    Worker& w = *workers_.front();
+    double inCells = 0;
+    tree_.build(keys, *cellSize_, [&](const KdTree::Leaf& leaf, std::span<const std::uint32_t> items) {
+      const auto c0 = Clock::now();
+      w.processCell(keys, items, &leaf, capacity_);
+      inCells += seconds(c0, Clock::now());
+    });
+    finishCells(out);
+    times_.cellsSeconds = inCells;
+    times_.treeSeconds = seconds(t0, Clock::now()) - inCells;
+  } else if (cellSize_) {
     tree_.build(keys, *cellSize_);
     const auto t1 = Clock::now();
     times_.treeSeconds = seconds(t0, t1);
@@ -112,14 +126,28 @@ void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out)
   times_.totalSeconds = times_.treeSeconds + times_.cellsSeconds;
 }
 
-void BroadPhase::processCells(std::span<const KeyBox> keys, std::vector<Pair>& out, Clock::time_point start) {
+void BroadPhase::startCells(Clock::time_point frameStart) {
   for (auto& w : workers_) {
     w->out.clear();
     w->stats = {};
     w->backendSeconds = 0;
-    w->frameStart = start;
+    w->frameStart = frameStart;
     w->runs.clear();
   }
+}
+
+void BroadPhase::finishCells(std::vector<Pair>& out) {
+  runs_.clear();
+  for (auto& w : workers_) {
+    out.insert(out.end(), w->out.begin(), w->out.end());
+    stats_ += w->stats;
+    times_.backendSeconds += w->backendSeconds;
+    runs_.insert(runs_.end(), w->runs.begin(), w->runs.end());
+  }
+}
+
+void BroadPhase::processCells(std::span<const KeyBox> keys, std::vector<Pair>& out, Clock::time_point start) {
+  startCells(start);
   if (!cellSize_) {
     identity_.resize(keys.size());
     std::iota(identity_.begin(), identity_.end(), 0u);
@@ -136,13 +164,7 @@ void BroadPhase::processCells(std::span<const KeyBox> keys, std::vector<Pair>& o
       });
     });
   }
-  runs_.clear();
-  for (auto& w : workers_) {
-    out.insert(out.end(), w->out.begin(), w->out.end());
-    stats_ += w->stats;
-    times_.backendSeconds += w->backendSeconds;
-    runs_.insert(runs_.end(), w->runs.begin(), w->runs.end());
-  }
+  finishCells(out);
 }
 
 // A cell within capacity is one run. A larger one is cut into k chunks of at

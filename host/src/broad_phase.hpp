@@ -63,6 +63,8 @@ class BroadPhase {
   struct Worker;
   class Pool;
   void processCells(std::span<const KeyBox> keys, std::vector<Pair>& out, std::chrono::steady_clock::time_point start);
+  void startCells(std::chrono::steady_clock::time_point frameStart);  // clears the workers' results
+  void finishCells(std::vector<Pair>& out);                            // gathers them
   void check() const;
 
   std::vector<std::unique_ptr<Worker>> workers_;

@@ -6,7 +6,7 @@
 
 namespace bpaccel {
 
-void KdTree::build(std::span<const KeyBox> boxes, std::size_t cellSize) {
+void KdTree::build(std::span<const KeyBox> boxes, std::size_t cellSize, const LeafSink& onLeaf) {
   checkObjectCount(boxes.size());
   leafItems_.clear();
   leaves_.clear();
@@ -24,6 +24,7 @@ void KdTree::build(std::span<const KeyBox> boxes, std::size_t cellSize) {
       leaves_.push_back({leafItems_.size(), task.count, task.lo, task.hi});
       leafItems_.insert(leafItems_.end(), items, items + task.count);
       work_.resize(task.begin);  // the next node on the stack owns the end again
+      if (onLeaf) onLeaf(leaves_.back(), this->items(leaves_.back()));
     }
   }
 }

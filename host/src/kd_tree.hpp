@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -32,10 +33,16 @@ class KdTree {
     }
   };
 
+  /// Called with each leaf as soon as it is final, while the build goes on.
+  /// The leaf and its items are valid during the call only.
+  using LeafSink = std::function<void(const Leaf&, std::span<const std::uint32_t> items)>;
+
   /// Splits until a cell holds at most `cellSize` boxes, or until no split
   /// helps (every plane is straddled by too many boxes): such a cell stays
-  /// larger than cellSize and is chunked by the caller.
-  void build(std::span<const KeyBox> boxes, std::size_t cellSize);
+  /// larger than cellSize and is chunked by the caller. Leaves come out in
+  /// depth-first order; `onLeaf` (if any) gets each one as it is made, so a
+  /// caller can process cells while the rest of the tree is being built.
+  void build(std::span<const KeyBox> boxes, std::size_t cellSize, const LeafSink& onLeaf = {});
 
   const std::vector<Leaf>& leaves() const { return leaves_; }
   /// Item entries the tree's buffers hold (their capacity): what its memory grows with.

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <optional>
+#include <random>
+#include <algorithm>
 #include <set>
 
 #include "all_pairs_kernel.hpp"
@@ -291,4 +293,62 @@ TEST(BroadPhase, RecordsEveryRunInOrderWithItsOwnCounters) {
   EXPECT_EQ(sum.loadCycles, bp.stats().loadCycles);
   EXPECT_EQ(sum.boxesSent, bp.stats().boxesSent);
   EXPECT_LE(last, bp.times().totalSeconds);
+}
+
+namespace {
+
+// Wraps a backend and records, at each run, how many leaves the tree had made.
+class LeafCountingBackend final : public Backend {
+ public:
+  LeafCountingBackend(Backend& inner, const BroadPhase*& phase) : inner_(inner), phase_(phase) {}
+  std::string name() const override { return inner_.name(); }
+  std::size_t capacity() const override { return inner_.capacity(); }
+  void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override {
+    leavesAtRun.push_back(phase_->tree().leaves().size());
+    inner_.run(boxes, out, stats);
+  }
+  std::vector<std::size_t> leavesAtRun;
+
+ private:
+  Backend& inner_;
+  const BroadPhase*& phase_;
+};
+
+}  // namespace
+
+TEST(BroadPhase, CellsReachTheBackendWhileTheTreeIsStillBeingBuilt) {
+  ModelBackend model(4, 64, 5);
+  const BroadPhase* phase = nullptr;
+  LeafCountingBackend counting(model, phase);
+  BroadPhase bp(counting, 16);
+  phase = &bp;
+  std::mt19937 gen(9);
+  std::uniform_real_distribution<float> pos(-40, 40), ext(0, 2);
+  std::vector<Aabb> boxes(2000);
+  for (auto& b : boxes) {
+    const float x = pos(gen), y = pos(gen), z = pos(gen);
+    b = box(x, y, z, x + ext(gen), y + ext(gen), z + ext(gen));
+  }
+  std::vector<Pair> pairs;
+  bp.findPairs(boxes, pairs);
+  const std::size_t leaves = bp.tree().leaves().size();
+  ASSERT_GT(leaves, 50u);
+  ASSERT_FALSE(counting.leavesAtRun.empty());
+  // The first cell runs when the tree has made one leaf, not all of them; and
+  // the runs follow the leaves as they are made.
+  EXPECT_EQ(counting.leavesAtRun.front(), 1u);
+  EXPECT_TRUE(std::is_sorted(counting.leavesAtRun.begin(), counting.leavesAtRun.end()));
+  EXPECT_EQ(sorted(pairs), bruteForce(boxes));
+  // The streamed frame is the same as processing the finished tree's leaves in order.
+  ModelBackend again(4, 64, 5);
+  RunStats sum;
+  std::vector<Pair> scratch;
+  std::vector<KeyBox> keys;
+  toKeys(boxes, keys);
+  for (const auto& leaf : bp.tree().leaves()) {
+    std::vector<KeyBox> cell;
+    for (auto i : bp.tree().items(leaf)) cell.push_back(keys[i]);
+    if (cell.size() >= 2) again.run(cell, scratch, sum);
+  }
+  EXPECT_EQ(sum.cycles, bp.stats().cycles);
 }
