@@ -4,9 +4,8 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include "keys.hpp"
 
@@ -99,31 +98,62 @@ void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out)
   stats_ = {};
   times_ = {};
   const auto t0 = Clock::now();
-  if (cellSize_ && !pool_) {
-    // One thread: each cell goes to the backend as soon as the tree has made
-    // it, so the first run is ready long before the tree is finished.
-    startCells(t0);
-    Worker& w = *workers_.front();
-    double inCells = 0;
-    tree_.build(keys, *cellSize_, [&](const KdTree::Leaf& leaf, std::span<const std::uint32_t> items) {
-      const auto c0 = Clock::now();
-      w.processCell(keys, items, &leaf, capacity_);
-      inCells += seconds(c0, Clock::now());
-    });
-    finishCells(out);
-    times_.cellsSeconds = inCells;
-    times_.treeSeconds = seconds(t0, Clock::now()) - inCells;
-  } else if (cellSize_) {
-    tree_.build(keys, *cellSize_);
-    const auto t1 = Clock::now();
-    times_.treeSeconds = seconds(t0, t1);
-    processCells(keys, out, t0);
-    times_.cellsSeconds = seconds(t1, Clock::now());
-  } else {
-    processCells(keys, out, t0);
+  startCells(t0);
+  if (!cellSize_) {
+    identity_.resize(keys.size());
+    std::iota(identity_.begin(), identity_.end(), 0u);
+    workers_.front()->processCell(keys, identity_, nullptr, capacity_);
     times_.cellsSeconds = seconds(t0, Clock::now());
+  } else if (!pool_) {
+    streamCells(keys);
+  } else {
+    streamCellsToThreads(keys);
   }
+  finishCells(out);
   times_.totalSeconds = times_.treeSeconds + times_.cellsSeconds;
+}
+
+// Each cell goes to the backend as soon as the tree has made it, so the
+// first run is ready long before the tree is finished.
+void BroadPhase::streamCells(std::span<const KeyBox> keys) {
+  const auto t0 = Clock::now();
+  Worker& w = *workers_.front();
+  double inCells = 0;
+  tree_.build(keys, *cellSize_, [&](const KdTree::Leaf& leaf, std::span<const std::uint32_t> items) {
+    const auto c0 = Clock::now();
+    w.processCell(keys, items, &leaf, capacity_);
+    inCells += seconds(c0, Clock::now());
+  });
+  times_.cellsSeconds = inCells;
+  times_.treeSeconds = seconds(t0, Clock::now()) - inCells;
+}
+
+// The calling thread builds the tree and hands each cell to the pool as a
+// task while it goes on; the other threads process cells meanwhile, and the
+// builder joins them when the tree is done. A task gets its own copy of the
+// cell's items: the tree's item storage grows (and moves) during the build.
+void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys) {
+  const auto t0 = Clock::now();
+  Clock::time_point built;
+  pool_->run([&] {
+    tbb::task_group tasks;
+    std::size_t used = 0;
+    tree_.build(keys, *cellSize_, [&](const KdTree::Leaf& leaf, std::span<const std::uint32_t> items) {
+      if (items.size() < 2) return;  // no pair
+      if (used == cellItems_.size()) cellItems_.emplace_back();  // a deque: earlier copies stay put
+      std::vector<std::uint32_t>& copy = cellItems_[used++];
+      copy.assign(items.begin(), items.end());
+      tasks.run([this, keys, leaf, cell = std::span<const std::uint32_t>(copy)] {
+        // Inside this arena, thread indices are 0 .. threads-1: one worker each.
+        Worker& w = *workers_.at(static_cast<std::size_t>(tbb::this_task_arena::current_thread_index()));
+        w.processCell(keys, cell, &leaf, capacity_);
+      });
+    });
+    built = Clock::now();
+    tasks.wait();
+  });
+  times_.treeSeconds = seconds(t0, built);
+  times_.cellsSeconds = seconds(built, Clock::now());
 }
 
 void BroadPhase::startCells(Clock::time_point frameStart) {
@@ -144,27 +174,6 @@ void BroadPhase::finishCells(std::vector<Pair>& out) {
     times_.backendSeconds += w->backendSeconds;
     runs_.insert(runs_.end(), w->runs.begin(), w->runs.end());
   }
-}
-
-void BroadPhase::processCells(std::span<const KeyBox> keys, std::vector<Pair>& out, Clock::time_point start) {
-  startCells(start);
-  if (!cellSize_) {
-    identity_.resize(keys.size());
-    std::iota(identity_.begin(), identity_.end(), 0u);
-    workers_.front()->processCell(keys, identity_, nullptr, capacity_);
-  } else if (!pool_) {
-    for (const KdTree::Leaf& leaf : tree_.leaves()) workers_.front()->processCell(keys, tree_.items(leaf), &leaf, capacity_);
-  } else {
-    const auto& leaves = tree_.leaves();
-    pool_->run([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const tbb::blocked_range<std::size_t>& r) {
-        // Inside this arena, thread indices are 0 .. threads-1: one worker each.
-        Worker& w = *workers_.at(static_cast<std::size_t>(tbb::this_task_arena::current_thread_index()));
-        for (std::size_t c = r.begin(); c != r.end(); ++c) w.processCell(keys, tree_.items(leaves[c]), &leaves[c], capacity_);
-      });
-    });
-  }
-  finishCells(out);
 }
 
 // A cell within capacity is one run. A larger one is cut into k chunks of at

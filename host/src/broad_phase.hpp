@@ -2,6 +2,7 @@
 // A whole-scene broad phase: keys, optional k-d tree, chunking, backend runs.
 
 #include <chrono>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -30,9 +31,11 @@ struct HostTimes {
 /// covered in chunks of capacity/2 boxes: every two chunks run together, and
 /// each pair is kept from exactly one of those runs.
 ///
-/// With several threads, the cells are shared out among workers, each with a
-/// backend of its own from the factory (backends keep scratch state and are
-/// not shared between threads); the tree is built on the calling thread.
+/// The cells go to the backend as the k-d tree makes them, while it goes on.
+/// With several threads, the calling thread builds the tree and the cells are
+/// shared out among workers as tasks, each worker with a backend of its own
+/// from the factory (backends keep scratch state and are not shared between
+/// threads).
 class BroadPhase {
  public:
   using BackendFactory = std::function<std::unique_ptr<Backend>()>;
@@ -62,7 +65,8 @@ class BroadPhase {
  private:
   struct Worker;
   class Pool;
-  void processCells(std::span<const KeyBox> keys, std::vector<Pair>& out, std::chrono::steady_clock::time_point start);
+  void streamCells(std::span<const KeyBox> keys);           // one thread: tree and cells interleaved
+  void streamCellsToThreads(std::span<const KeyBox> keys);  // the pool: cells as tasks while the tree goes on
   void startCells(std::chrono::steady_clock::time_point frameStart);  // clears the workers' results
   void finishCells(std::vector<Pair>& out);                            // gathers them
   void check() const;
@@ -74,6 +78,7 @@ class BroadPhase {
   KdTree tree_;
   std::vector<KeyBox> keys_;
   std::vector<std::uint32_t> identity_;  // 0..n-1: the scene as one cell
+  std::deque<std::vector<std::uint32_t>> cellItems_;  // the pool's copies of cells' items, kept between frames
   RunStats stats_;
   HostTimes times_;
   std::vector<RunRecord> runs_;
