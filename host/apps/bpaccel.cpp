@@ -238,7 +238,7 @@ int main(int argc, char** argv) {
                        "Skip methods that test all pairs (btSimpleBroadphase, k-d none) where n(n-1)/2 exceeds this")
       ->check(CLI::PositiveNumber)->capture_default_str();
   benchCmd->add_option("--max-sweep-tests", lineUp.maxSweepTests,
-                       "Skip sweeps that cannot be stopped midway (FCL SaP, rebuilt each frame) where more pairs "
+                       "Skip sweeps that cannot be stopped midway (FCL SaP rebuilt each frame, ODE sweep and prune) where more pairs "
                        "than this overlap on x")
       ->check(CLI::PositiveNumber)->capture_default_str();
   benchCmd->add_option("--max-method-seconds", bench.maxMethodSeconds,

@@ -95,7 +95,7 @@ SetDifference compareSorted(const std::vector<Pair>& got, const std::vector<Pair
 
 std::vector<MethodSpec> standardLineUp(const LineUpConfig& config) {
   std::vector<MethodSpec> specs = bulletMethods(config.maxAllPairsTests);
-  for (auto&& group : {fclMethods(config.maxSweepTests), cgalMethods(), odeMethods()})
+  for (auto&& group : {fclMethods(config.maxSweepTests), cgalMethods(), odeMethods(config.maxSweepTests)})
     for (auto& s : group) specs.push_back(s);
   if (config.device)
     for (auto& s : acceleratorMethods(config.device, config.cellSizes, config.maxAllPairsTests))

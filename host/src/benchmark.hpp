@@ -39,7 +39,8 @@ struct LineUpConfig {
   /// Methods that test all n(n-1)/2 pairs a frame are skipped above this.
   double maxAllPairsTests = 1e8;
   /// A sweep along x that cannot be stopped midway (FCL's SaP, rebuilt every
-  /// frame) is skipped where more pairs than this overlap on x.
+  /// frame, and ODE's sweep-and-prune space) is skipped where more pairs than
+  /// this overlap on x.
   double maxSweepTests = 1e9;
   std::shared_ptr<const DeviceConfig> device;  // the accelerator's; none: no accelerator methods
   /// Above 1: the cpu backend also runs on this many threads, per cell size with a tree.

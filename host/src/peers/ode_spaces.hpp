@@ -29,6 +29,8 @@ class OdeSpace final : public TimedMethod {
   std::vector<Pair> pairs_;
 };
 
-std::vector<MethodSpec> odeMethods();
+/// ODE's hash space and sweep-and-prune space. The latter is skipped where
+/// more than `maxSweepTests` pairs overlap on x (sweepSkipReason).
+std::vector<MethodSpec> odeMethods(double maxSweepTests);
 
 }  // namespace bpaccel
