@@ -69,9 +69,9 @@ bench: host
 
 # The seed's sizes, 100,000 and 1,000,000 objects: device cycles from the
 # cycle-exact model backend (the Verilated one would take hours), every frame
-# of every method still validated, a few frames a row. The 100,000 row took
-# 13 min on a loaded 2-core machine (9 of them bt32BitAxisSweep3's O(n^2)
-# set-up); --max-method-seconds bounds the slowest methods of the 1,000,000 row.
+# of every method still validated, a few frames a row. Methods whose set-up or
+# sweep cannot be stopped midway are skipped with their reason where they would
+# take many minutes (docs/results.md); --max-method-seconds stops the others.
 BENCH_LARGE_ARGS ?= --objects 100000 1000000 --backend model --frames 3 --warmup 1
 .PHONY: bench-large
 bench-large: host

@@ -15,6 +15,7 @@
 #include "bpaccel_params.h"
 #include "bullet_broadphase.hpp"
 #include "exact_pairs.hpp"
+#include "peers/ode_spaces.hpp"
 #include "rtl_backend.hpp"
 #include "scene.hpp"
 #include "scenes.hpp"
@@ -284,6 +285,16 @@ TEST(Benchmark, TheAxisSweepIsSkippedWhereItsSetUpTakesMinutes) {
     const auto reason = axisSweepSkipReason(n);
     ASSERT_TRUE(reason.has_value()) << n;
     EXPECT_NE(reason->find("Theta(n^2)"), std::string::npos);
+  }
+}
+
+TEST(Benchmark, OdesHashSpaceIsSkippedWhereItsPairTableOverflowsAnInt) {
+  EXPECT_FALSE(hashSpaceSkipReason(100000).has_value());
+  EXPECT_FALSE(hashSpaceSkipReason(131071).has_value());  // 131071 * 16384 bytes = INT_MAX - 16383
+  for (std::size_t n : {131072u, 300000u, 1000000u}) {
+    const auto reason = hashSpaceSkipReason(n);
+    ASSERT_TRUE(reason.has_value()) << n;
+    EXPECT_NE(reason->find("aborts"), std::string::npos) << *reason;
   }
 }
 

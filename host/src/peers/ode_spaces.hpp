@@ -29,6 +29,10 @@ class OdeSpace final : public TimedMethod {
   std::vector<Pair> pairs_;
 };
 
+/// Why dHashSpace cannot run at `objects`, if it cannot: its table of tested
+/// pairs (n^2/8 bytes) overflows an int beyond 131,071 objects and ODE aborts.
+std::optional<std::string> hashSpaceSkipReason(std::size_t objects);
+
 /// ODE's hash space and sweep-and-prune space. The latter is skipped where
 /// more than `maxSweepTests` pairs overlap on x (sweepSkipReason).
 std::vector<MethodSpec> odeMethods(double maxSweepTests);
