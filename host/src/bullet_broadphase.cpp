@@ -1,4 +1,5 @@
 #include "bullet_broadphase.hpp"
+#include "bullet_pairs.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -70,20 +71,15 @@ BulletBroadphase::BulletBroadphase(Kind kind, std::span<const Aabb> initial, flo
 }
 
 // btDbvtBroadphase allocates every proxy and frees it only in destroyProxy
-// (LeakSanitizer reports the rest), so its proxies are destroyed first. Its
-// destroyProxy scans the whole pair cache for the proxy's pairs, O(n * pairs)
-// over all proxies (24 s at 100,000 objects), so the pairs go first, each by
-// its hash in O(1), and every scan is then of an empty cache. The
+// (LeakSanitizer reports the rest), so its proxies are destroyed first, after
+// its pairs (removeAllOverlappingPairs says why). The
 // sweep (built without a raycast accelerator) and the simple broad phase keep
 // their proxies in arrays they free themselves; destroying them one by one
 // would cost the sweep O(n^2) (each removal moves its edges to the end of
 // every axis). No pair holds a collision algorithm: nothing was dispatched.
 BulletBroadphase::~BulletBroadphase() {
   if (kind_ != Kind::Dbvt) return;
-  btOverlappingPairCache* cache = broadphase_->getOverlappingPairCache();
-  const btBroadphasePairArray pairs = cache->getOverlappingPairArray();  // a copy: removal reorders the original
-  for (int k = 0; k < pairs.size(); ++k)
-    cache->removeOverlappingPair(pairs[k].m_pProxy0, pairs[k].m_pProxy1, dispatcher_.get());
+  removeAllOverlappingPairs(*broadphase_->getOverlappingPairCache(), dispatcher_.get());
   for (btBroadphaseProxy* p : proxies_) broadphase_->destroyProxy(p, dispatcher_.get());
 }
 

@@ -7,6 +7,8 @@
 #include <btBulletDynamicsCommon.h>
 #include <fmt/format.h>
 
+#include "bullet_pairs.hpp"
+
 namespace bpaccel {
 
 float SceneConfig::cubeEdge() const { return std::cbrt(static_cast<float>(objects) / density); }
@@ -84,6 +86,7 @@ BouncingCubeScene::BouncingCubeScene(const SceneConfig& config, std::unique_ptr<
 }
 
 BouncingCubeScene::~BouncingCubeScene() {
+  removeAllOverlappingPairs(*world_->getBroadphase()->getOverlappingPairCache(), dispatcher_.get());
   for (auto& b : bodies_) world_->removeRigidBody(b.get());
   for (auto& w : walls_) world_->removeRigidBody(w.get());
 }
