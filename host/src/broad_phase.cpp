@@ -24,7 +24,7 @@ enum Keep : int { kCross = 1, kFirstInside = 2, kSecondInside = 4 };
 struct BroadPhase::Worker {
   std::unique_ptr<Backend> owned;
   Backend* backend = nullptr;
-  std::vector<KeyBox> batch;            // a cell's boxes, packed for the backend
+  std::vector<KeyBox> gathered;         // a chunk pair's boxes, packed for the backend
   std::vector<Pair> local;              // pairs of one run, batch indices
   std::vector<Pair> out;                // this worker's share of the frame's pairs
   RunStats stats;
@@ -32,10 +32,12 @@ struct BroadPhase::Worker {
   Clock::time_point frameStart;
   std::vector<RunRecord> runs;
 
-  void runBatch(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, const KdTree::Leaf* region,
-                std::size_t splitAt, int keep);
-  void processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, const KdTree::Leaf* region,
-                   std::size_t capacity);
+  // `packed`: the cell's boxes in item order when the caller has them (the
+  // tree's leaves, the whole scene), else empty: they are gathered from `keys`.
+  void runBatch(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
+                const KdTree::Leaf* region, std::size_t splitAt, int keep);
+  void processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
+                   const KdTree::Leaf* region, std::size_t capacity);
 };
 
 /// The threads of a multi-threaded BroadPhase: an arena of its own, so the
@@ -102,7 +104,7 @@ void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out)
   if (!cellSize_) {
     identity_.resize(keys.size());
     std::iota(identity_.begin(), identity_.end(), 0u);
-    workers_.front()->processCell(keys, identity_, nullptr, capacity_);
+    workers_.front()->processCell(keys, identity_, keys, nullptr, capacity_);
     times_.cellsSeconds = seconds(t0, Clock::now());
   } else if (!pool_) {
     streamCells(keys);
@@ -119,9 +121,10 @@ void BroadPhase::streamCells(std::span<const KeyBox> keys) {
   const auto t0 = Clock::now();
   Worker& w = *workers_.front();
   double inCells = 0;
-  tree_.build(keys, *cellSize_, [&](const KdTree::Leaf& leaf, std::span<const std::uint32_t> items) {
+  tree_.build(keys, *cellSize_, [&](const KdTree::Leaf& leaf, std::span<const std::uint32_t> items,
+                                    std::span<const KeyBox> packed) {
     const auto c0 = Clock::now();
-    w.processCell(keys, items, &leaf, capacity_);
+    w.processCell(keys, items, packed, &leaf, capacity_);
     inCells += seconds(c0, Clock::now());
   });
   times_.cellsSeconds = inCells;
@@ -131,22 +134,24 @@ void BroadPhase::streamCells(std::span<const KeyBox> keys) {
 // The calling thread builds the tree and hands each cell to the pool as a
 // task while it goes on; the other threads process cells meanwhile, and the
 // builder joins them when the tree is done. A task gets its own copy of the
-// cell's items: the tree's item storage grows (and moves) during the build.
+// cell's items and boxes: the tree's storage changes as the build goes on.
 void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys) {
   const auto t0 = Clock::now();
   Clock::time_point built;
   pool_->run([&] {
     tbb::task_group tasks;
     std::size_t used = 0;
-    tree_.build(keys, *cellSize_, [&](const KdTree::Leaf& leaf, std::span<const std::uint32_t> items) {
+    tree_.build(keys, *cellSize_, [&](const KdTree::Leaf& leaf, std::span<const std::uint32_t> items,
+                                      std::span<const KeyBox> packed) {
       if (items.size() < 2) return;  // no pair
-      if (used == cellItems_.size()) cellItems_.emplace_back();  // a deque: earlier copies stay put
-      std::vector<std::uint32_t>& copy = cellItems_[used++];
-      copy.assign(items.begin(), items.end());
-      tasks.run([this, keys, leaf, cell = std::span<const std::uint32_t>(copy)] {
+      if (used == cellCopies_.size()) cellCopies_.emplace_back();  // a deque: earlier copies stay put
+      CellCopy& copy = cellCopies_[used++];
+      copy.items.assign(items.begin(), items.end());
+      copy.packed.assign(packed.begin(), packed.end());
+      tasks.run([this, keys, leaf, &copy] {
         // Inside this arena, thread indices are 0 .. threads-1: one worker each.
         Worker& w = *workers_.at(static_cast<std::size_t>(tbb::this_task_arena::current_thread_index()));
-        w.processCell(keys, cell, &leaf, capacity_);
+        w.processCell(keys, copy.items, copy.packed, &leaf, capacity_);
       });
     });
     built = Clock::now();
@@ -181,10 +186,11 @@ void BroadPhase::finishCells(std::vector<Pair>& out) {
 // pairs, and each chunk's inside pairs are kept from exactly one run: chunk
 // p from run (p, p+1), the last chunk from run (k-2, k-1).
 void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
-                                     const KdTree::Leaf* region, std::size_t capacity) {
+                                     std::span<const KeyBox> packed, const KdTree::Leaf* region,
+                                     std::size_t capacity) {
   if (items.size() < 2) return;
   if (items.size() <= capacity) {
-    runBatch(keys, items, region, items.size(), kFirstInside);
+    runBatch(keys, items, packed, region, items.size(), kFirstInside);
     return;
   }
   const std::size_t chunk = capacity / 2;
@@ -199,22 +205,27 @@ void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<con
       int keep = kCross;
       if (q == p + 1) keep |= kFirstInside;
       if (p == k - 2 && q == k - 1) keep |= kSecondInside;
-      runBatch(keys, pairItems, region, first.size(), keep);
+      runBatch(keys, pairItems, {}, region, first.size(), keep);
     }
   }
 }
 
 void BroadPhase::Worker::runBatch(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
-                                  const KdTree::Leaf* region, std::size_t splitAt, int keep) {
-  batch.resize(items.size());
-  for (std::size_t t = 0; t < items.size(); ++t) batch[t] = keys[items[t]];
+                                  std::span<const KeyBox> packed, const KdTree::Leaf* region, std::size_t splitAt,
+                                  int keep) {
+  if (packed.empty()) {
+    gathered.resize(items.size());
+    for (std::size_t t = 0; t < items.size(); ++t) gathered[t] = keys[items[t]];
+    packed = gathered;
+  }
+  const std::span<const KeyBox> batch = packed;
   local.clear();
   RunRecord record;
-  const auto packed = Clock::now();
-  record.readySeconds = seconds(frameStart, packed) - backendSeconds;
+  const auto ready = Clock::now();
+  record.readySeconds = seconds(frameStart, ready) - backendSeconds;
   backend->run(batch, local, record.stats);
   const auto ran = Clock::now();
-  backendSeconds += seconds(packed, ran);
+  backendSeconds += seconds(ready, ran);
   stats += record.stats;
   for (const auto& [a, b] : local) {
     const bool firstA = a < splitAt, firstB = b < splitAt;

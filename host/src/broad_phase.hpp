@@ -78,7 +78,11 @@ class BroadPhase {
   KdTree tree_;
   std::vector<KeyBox> keys_;
   std::vector<std::uint32_t> identity_;  // 0..n-1: the scene as one cell
-  std::deque<std::vector<std::uint32_t>> cellItems_;  // the pool's copies of cells' items, kept between frames
+  struct CellCopy {
+    std::vector<std::uint32_t> items;
+    std::vector<KeyBox> packed;
+  };
+  std::deque<CellCopy> cellCopies_;  // the pool's copies of cells, kept between frames
   RunStats stats_;
   HostTimes times_;
   std::vector<RunRecord> runs_;

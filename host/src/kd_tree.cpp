@@ -6,7 +6,7 @@
 
 namespace bpaccel {
 
-void KdTree::build(std::span<const KeyBox> boxes, std::size_t cellSize, const LeafSink& onLeaf) {
+void KdTree::build(std::span<const KeyBox> boxes, std::size_t cellSize, const LeafSink& onLeaf, Layout layout) {
   checkObjectCount(boxes.size());
   leafItems_.clear();
   leaves_.clear();
@@ -14,17 +14,27 @@ void KdTree::build(std::span<const KeyBox> boxes, std::size_t cellSize, const Le
   const auto n = static_cast<std::uint32_t>(boxes.size());
   work_.resize(n);
   for (std::uint32_t i = 0; i < n; ++i) work_[i] = i;
+  const bool carried = layout == Layout::Carried || (layout == Layout::Auto && boxes.size() > kCarryAbove);
+  if (carried)
+    workKeys_.assign(boxes.begin(), boxes.end());
+  else
+    workKeys_.clear();
   constexpr std::uint64_t kTop = std::uint64_t{1} << 32;
   stack_.push_back({0, n, {0, 0, 0}, {kTop, kTop, kTop}});
   while (!stack_.empty()) {
     const Task task = stack_.back();
     stack_.pop_back();
-    if (task.count <= cellSize || !split(boxes, task)) {
+    if (task.count <= cellSize || !(carried ? split<true>(boxes, task) : split<false>(boxes, task))) {
       const auto items = work_.begin() + static_cast<std::ptrdiff_t>(task.begin);
       leaves_.push_back({leafItems_.size(), task.count, task.lo, task.hi});
       leafItems_.insert(leafItems_.end(), items, items + task.count);
+      if (onLeaf) {
+        std::span<const KeyBox> packed;
+        if (carried) packed = std::span<const KeyBox>(workKeys_).subspan(static_cast<std::size_t>(task.begin), task.count);
+        onLeaf(leaves_.back(), this->items(leaves_.back()), packed);
+      }
       work_.resize(task.begin);  // the next node on the stack owns the end again
-      if (onLeaf) onLeaf(leaves_.back(), this->items(leaves_.back()));
+      if (carried) workKeys_.resize(task.begin);
     }
   }
 }
@@ -34,12 +44,14 @@ void KdTree::build(std::span<const KeyBox> boxes, std::size_t cellSize, const Le
 // spread down and splits at the sampled median. A split must shrink both
 // children and may duplicate at most a quarter of the boxes, which bounds
 // the tree's size. Each level costs one pass over its boxes.
+template <bool kCarried>
 bool KdTree::split(std::span<const KeyBox> boxes, const Task& task) {
   constexpr std::uint32_t kSamples = 63;
   const std::uint32_t samples = std::min(kSamples, task.count);
   std::array<std::array<std::uint64_t, kSamples>, 3> centres;  // twice the centre, per axis
   for (std::uint32_t t = 0; t < samples; ++t) {
-    const KeyBox& b = boxes[work_[task.begin + std::uint64_t{t} * task.count / samples]];
+    const std::uint64_t at = task.begin + std::uint64_t{t} * task.count / samples;
+    const KeyBox& b = kCarried ? workKeys_[at] : boxes[work_[at]];
     for (int a = 0; a < 3; ++a) centres[a][t] = std::uint64_t{b.min[a]} + b.max[a];
   }
   std::array<std::uint64_t, 3> spread{}, lowest{};
@@ -66,12 +78,20 @@ bool KdTree::split(std::span<const KeyBox> boxes, const Task& task) {
       left_.resize(task.count);
       right_.resize(task.count);
     }
+    if (kCarried && leftKeys_.size() < task.count) {
+      leftKeys_.resize(task.count);
+      rightKeys_.resize(task.count);
+    }
     std::uint32_t left = 0, right = 0;
     for (std::uint32_t t = 0; t < task.count; ++t) {
       const std::uint32_t id = work_[task.begin + t];
-      const KeyBox& b = boxes[id];
+      const KeyBox& b = kCarried ? workKeys_[task.begin + t] : boxes[id];
       left_[left] = id;
       right_[right] = id;
+      if constexpr (kCarried) {
+        leftKeys_[left] = b;
+        rightKeys_[right] = b;
+      }
       left += b.min[axis] < plane;
       right += b.max[axis] >= plane;
     }
@@ -83,6 +103,11 @@ bool KdTree::split(std::span<const KeyBox> boxes, const Task& task) {
     work_.resize(task.begin);
     work_.insert(work_.end(), right_.begin(), right_.begin() + right);
     work_.insert(work_.end(), left_.begin(), left_.begin() + left);
+    if constexpr (kCarried) {
+      workKeys_.resize(task.begin);
+      workKeys_.insert(workKeys_.end(), rightKeys_.begin(), rightKeys_.begin() + right);
+      workKeys_.insert(workKeys_.end(), leftKeys_.begin(), leftKeys_.begin() + left);
+    }
     Task lower = task, upper = task;
     upper.count = right;
     upper.lo[axis] = plane;

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <optional>
 #include <random>
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include "backend.hpp"
 #include "broad_phase.hpp"
 #include "bpaccel_params.h"
+#include "exact_pairs.hpp"
 #include "keys.hpp"
 #include "scenes.hpp"
 
@@ -351,4 +353,63 @@ TEST(BroadPhase, CellsReachTheBackendWhileTheTreeIsStillBeingBuilt) {
     if (cell.size() >= 2) again.run(cell, scratch, sum);
   }
   EXPECT_EQ(sum.cycles, bp.stats().cycles);
+}
+
+TEST(KdTree, CarriedAndGatheredLayoutsGiveTheSameLeavesAndPackedBoxes) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    for (const auto& [name, boxes] : adversarialScenes(900, seed)) {
+      std::vector<KeyBox> keys;
+      toKeys(boxes, keys);
+      for (std::size_t cell : {2u, 16u, 100u}) {
+        struct Seen {
+          KdTree::Leaf leaf;
+          std::vector<std::uint32_t> items;
+          std::vector<KeyBox> packed;
+        };
+        std::vector<Seen> gathered, carried;
+        KdTree a, b;
+        a.build(keys, cell, [&](const KdTree::Leaf& l, auto items, auto packed) {
+          EXPECT_TRUE(packed.empty());
+          gathered.push_back({l, {items.begin(), items.end()}, {}});
+        }, KdTree::Layout::Gathered);
+        b.build(keys, cell, [&](const KdTree::Leaf& l, auto items, auto packed) {
+          carried.push_back({l, {items.begin(), items.end()}, {packed.begin(), packed.end()}});
+        }, KdTree::Layout::Carried);
+        const std::string label = name + " cell " + std::to_string(cell);
+        ASSERT_EQ(gathered.size(), carried.size()) << label;
+        for (std::size_t k = 0; k < gathered.size(); ++k) {
+          EXPECT_EQ(gathered[k].items, carried[k].items) << label;
+          EXPECT_EQ(gathered[k].leaf.lo, carried[k].leaf.lo) << label;
+          EXPECT_EQ(gathered[k].leaf.hi, carried[k].leaf.hi) << label;
+          ASSERT_EQ(carried[k].packed.size(), carried[k].items.size()) << label;
+          for (std::size_t t = 0; t < carried[k].items.size(); ++t)
+            EXPECT_TRUE(carried[k].packed[t].min == keys[carried[k].items[t]].min &&
+                        carried[k].packed[t].max == keys[carried[k].items[t]].max)
+                << label;
+        }
+      }
+    }
+  }
+}
+
+TEST(BroadPhase, ScenesLargerThanTheCarryThresholdAreExactOnOneAndTwoThreads) {
+  // Above KdTree::kCarryAbove the tree carries boxes and hands cells over packed.
+  std::mt19937 gen(5);
+  const std::size_t n = KdTree::kCarryAbove + 1000;
+  const float edge = std::cbrt(static_cast<float>(n) / 0.05f);
+  std::uniform_real_distribution<float> pos(0, edge), ext(0.5f, 2);
+  std::vector<Aabb> boxes(n);
+  for (auto& b : boxes) {
+    const float x = pos(gen), y = pos(gen), z = pos(gen);
+    b = box(x, y, z, x + ext(gen), y + ext(gen), z + ext(gen));
+  }
+  std::vector<Pair> exact, pairs;
+  exactPairs(boxes, exact);
+  CpuBackend cpu;
+  BroadPhase one(cpu, 64);
+  one.findPairs(boxes, pairs);
+  EXPECT_EQ(sorted(pairs), exact);
+  BroadPhase two([] { return std::make_unique<CpuBackend>(); }, 64, 2);
+  two.findPairs(boxes, pairs);
+  EXPECT_EQ(sorted(pairs), exact);
 }
