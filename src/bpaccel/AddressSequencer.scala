@@ -68,7 +68,7 @@ class AddressSequencer(p: AccelParams) extends Module {
     hasNextBlock := cyclesAfter >= m.U
     blockStart   := true.B
     rotate       := (1 % m).U
-    advancing    := UIntToOH((1 % m).U(p.laneWidth.W), m)
+    advancing    := (1 << (1 % m)).U(m.W)
     capture      := 1.U
     for (k <- 0 until m) bRows(k) := (if (k == 0) row +& 1.U else row)
   }
@@ -104,8 +104,10 @@ class AddressSequencer(p: AccelParams) extends Module {
     }
   }
 
-  when(io.start.valid) {
-    active := io.start.bits >= 2.U
-    startBlock(0.U, 0.U, io.start.bits - 2.U)
-  }
+  // While idle, block 0's state follows n, so the start only sets `active`:
+  // the start's error decoding (n against the boxes loaded) then selects one
+  // flip-flop instead of every register of the sequencer (it was the m = 8
+  // critical path once the block-end test was registered).
+  when(!active) { startBlock(0.U, 0.U, io.start.bits - 2.U) }
+  when(io.start.valid) { active := io.start.bits >= 2.U }
 }

@@ -47,7 +47,7 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
 
   // Read back block 0's A objects the cycle after they are written.
   val loadRead = RegNext(
-    Mux(io.write.valid && io.write.bits.row === 0.U, UIntToOH(io.write.bits.lane, m), 0.U(m.W)),
+    VecInit(Seq.tabulate(m)(k => io.write.valid && io.write.bits.row === 0.U && io.write.bits.lane === k.U)).asUInt,
     0.U(m.W)
   )
   // While idle every port reads row 0.
