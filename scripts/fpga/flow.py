@@ -434,6 +434,9 @@ def flow(args) -> int:
         "dp16kd_per_memory": per_mem,
         "memories_in_bram": mems_in_bram,
         "note": (f"one memory of six keys a row, {dp16} DP16KD" if arch == "stream" and mems_in_bram else
+                 "each memory has one write and one read port; Yosys maps it to one "
+                 "pseudo-dual-port DP16KD (512x36), using 256 of its 512 rows"
+                 if mems_in_bram and per_mem == 1 else
                  "each memory has one read/write and one read port; Yosys maps it to two "
                  "pseudo-dual-port DP16KD (1 write + 1 read port, 512x36), written together, one per "
                  "read port: 2 DP16KD per memory, each using 256 of its 512 rows"
@@ -678,8 +681,8 @@ def base_report(m, capacity, params, args, versions, wrapper_info) -> dict:
 def xilinx(runner: Runner, debian_yosys: str, src_list: str, n_mems: int) -> dict:
     if not Path(debian_yosys).exists():
         raise FlowError(EXIT_TOOL, f"{debian_yosys} not found (apt-get install yosys)")
-    # -flatten: the memory module has separate clock ports for its two ports; only after
-    # flattening does Yosys see that both are `clock` and map the memory to block RAM.
+    # -flatten: one netlist for the whole core, as the ECP5 run sees it (the memory modules
+    # have one clock input and also map to block RAM on their own).
     (runner.work / "xilinx.ys").write_text(
         f"read_verilog -sv {src_list}\n"
         f"synth_xilinx -flatten -family {XILINX_FAMILY} -top {TOP}\n"

@@ -47,6 +47,8 @@ object EmitVerilog {
       Array("--target", "systemverilog", "--split-verilog", "--target-dir", targetDir.toString),
       Seq(ChiselGeneratorAnnotation(() => new BroadPhaseAccel(p))) ++ firtoolOptions.map(FirtoolOption(_))
     )
+    // One clock port per memory, so each maps to block RAM when synthesised on its own.
+    SingleClockMemories.rewrite(targetDir)
     Files.writeString(targetDir.resolve("bpaccel_params.h"), CHeader(p))
     Files.writeString(targetDir.resolve(lintWaivers), lintWaiverText)
     targetDir.resolve("filelist.f")

@@ -10,6 +10,24 @@ import chisel3.util._
   * issue -> memory read -> memory output registers -> rotator register ->
   * comparator/AND register. The sequencer only issues when the top level
   * grants a credit (`advance`), so the pipeline itself never stalls.
+  *
+  * Each memory has a single read port, busy with the B window every cycle, so
+  * the A block is never read: it sits in registers (`aBlock`). The next
+  * block's A objects pass through the B ports during the current block (B port
+  * k reads object (b+1)*m+k in the block's cycle k, see [[AddressSequencer]]),
+  * and `aNext(k)` captures memory k's data there, after the output registers.
+  * `aBlock` takes `aNext` when a block's first cycle reaches that stage, so
+  * each capture lands before the block that uses it and after the block
+  * that uses the previous contents: no extra port, no extra cycle.
+  *
+  * Block 0's A objects 0 .. m-1 never pass a B window. While loading, the B
+  * ports are free: the cycle after object k < m is written (memory k, row 0),
+  * B port k reads it back and `aNext(k)` captures it the same way. A run
+  * starts at the earliest one cycle after its last load, so these reads
+  * never meet an issue and land before block 0's first cycle does.
+  *
+  * No A register has a multiplexer in front of it: `aNext(k)` loads from
+  * memory k's read data, `aBlock` from `aNext` (clock enables only).
   */
 class SeedEngine(p: AccelParams) extends Engine(p) {
   private val m = p.m
@@ -27,51 +45,79 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   sequencer.io.advance := io.advance
   val issue = sequencer.io.issue
 
-  buffer.io.readEnable := sequencer.io.active
-  buffer.io.aRow       := issue.bits.aRow
-  buffer.io.bRows      := issue.bits.bRows
+  // Read back block 0's A objects the cycle after they are written.
+  val loadRead = RegNext(
+    VecInit(Seq.tabulate(m)(k => io.write.valid && io.write.bits.row === 0.U && io.write.bits.lane === k.U)).asUInt,
+    0.U(m.W)
+  )
+  // While idle every port reads row 0.
+  val readRows = VecInit(issue.bits.bRows.map(r => Mux(sequencer.io.active, r, 0.U)))
+  buffer.io.readEnable := sequencer.io.active || loadRead.orR
+  buffer.io.rows       := readRows
+
+  /** The object each memory's read port reads (debug tags only). */
+  private val portObjects = VecInit(Seq.tabulate(m)(k => (readRows(k) * m.U + k.U)(p.indexWidth - 1, 0)))
+  private def tags(v: Vec[UInt]): Vec[UInt] = if (p.debugPort) v else VecInit(Seq.fill(m)(0.U(0.W)))
+  private val tagWidth = if (p.debugPort) p.indexWidth else 0
 
   class Meta extends Bundle {
-    val iBase    = UInt(p.indexWidth.W)
-    val jBase    = UInt(p.indexWidth.W)
-    val laneMask = UInt(m.W)
-    val rotate   = UInt(p.laneWidth.W)
-    val probeI   = Vec(m, UInt(p.indexWidth.W)) // only used with the debug port
-    val probeJ   = Vec(m, UInt(p.indexWidth.W))
+    val iBase      = UInt(p.indexWidth.W)
+    val jBase      = UInt(p.indexWidth.W)
+    val laneMask   = UInt(m.W)
+    val rotate     = UInt(p.laneWidth.W)
+    val blockStart = Bool()
+    val probeJ     = Vec(m, UInt(tagWidth.W)) // the B objects each lane sees (debug port only)
   }
   val meta = Wire(new Meta)
-  meta.iBase    := issue.bits.iBase
-  meta.jBase    := issue.bits.jBase
-  meta.laneMask := issue.bits.laneMask
-  meta.rotate   := issue.bits.rotate
-  if (p.debugPort) {
-    // The objects each lane really sees: derived from the row addresses given
-    // to the memories and the rotator's selection, not from iBase/jBase.
-    meta.probeI := VecInit(Seq.tabulate(m)(k => (issue.bits.aRow * m.U + k.U)(p.indexWidth - 1, 0)))
-    val portObjects = VecInit(Seq.tabulate(m)(k => (issue.bits.bRows(k) * m.U + k.U)(p.indexWidth - 1, 0)))
-    meta.probeJ := Rotator(portObjects, issue.bits.rotate)
-  } else {
-    meta.probeI := DontCare
-    meta.probeJ := DontCare
+  meta.iBase      := issue.bits.iBase
+  meta.jBase      := issue.bits.jBase
+  meta.laneMask   := issue.bits.laneMask
+  meta.rotate     := issue.bits.rotate
+  meta.blockStart := issue.bits.blockStart
+  // Derived from the row addresses given to the memories and the rotator's selection, not from jBase.
+  meta.probeJ := (if (p.debugPort) Rotator(portObjects, issue.bits.rotate) else tags(portObjects))
+
+  /** Which memories' read data the A registers take, and (debug) which objects that data is. */
+  class Capture extends Bundle {
+    val lanes = UInt(m.W)
+    val tags  = Vec(m, UInt(tagWidth.W))
   }
+  val capture = Wire(new Capture)
+  capture.lanes := Mux(issue.valid, issue.bits.capture, loadRead)
+  capture.tags  := tags(portObjects)
 
   // Memory read (1 cycle), then the memory output registers.
-  val atMemory = Pipe(issue.valid, meta)
-  val memoryStages = Seq.iterate((buffer.io.a, buffer.io.b, atMemory), p.memoryOutputStages + 1) {
-    case (a, b, at) => (RegNext(a), RegNext(b), Pipe(at))
+  val memoryStages = Seq.iterate(
+    (buffer.io.data, Pipe(issue.valid, meta), Pipe(issue.valid || loadRead.orR, capture)),
+    p.memoryOutputStages + 1
+  ) { case (data, at, cap) => (RegNext(data), Pipe(at), Pipe(cap)) }
+  val (memData, atBuffered, captureAt) = memoryStages.last
+
+  // The A blocks, captured from the read data.
+  val aNext     = Reg(Vec(m, new Aabb(p.keyWidth)))
+  val aNextTag  = Reg(Vec(m, UInt(tagWidth.W)))
+  val aBlock    = Reg(Vec(m, new Aabb(p.keyWidth)))
+  val aBlockTag = Reg(Vec(m, UInt(tagWidth.W)))
+  when(atBuffered.valid && atBuffered.bits.blockStart) {
+    aBlock    := aNext
+    aBlockTag := aNextTag
   }
-  val (memA, memB, atBuffered) = memoryStages.last
-  // Rotator, registered.
-  val rotatedB  = RegNext(Rotator(memB, atBuffered.bits.rotate))
-  val alignedA  = RegNext(memA)
+  for (k <- 0 until m) when(captureAt.valid && captureAt.bits.lanes(k)) {
+    aNext(k)    := memData(k)
+    aNextTag(k) := captureAt.bits.tags(k)
+  }
+
+  // Rotator, registered; the A block is already a register.
+  val rotatedB  = RegNext(Rotator(memData, atBuffered.bits.rotate))
   val atRotated = Pipe(atBuffered)
   // Comparators and AND gates, registered.
-  compare.io.a := alignedA
+  compare.io.a := aBlock
   compare.io.b := rotatedB
   val hitMask   = RegNext(compare.io.hits & atRotated.bits.laneMask)
   val atCompare = Pipe(atRotated)
+  val probeI    = RegNext(aBlockTag)
 
-  val stages = memoryStages.map(_._3) ++ Seq(atRotated, atCompare)
+  val stages = memoryStages.map(_._2) ++ Seq(atRotated, atCompare)
   require(stages.length == p.pipelineLatency)
 
   io.activity.active   := sequencer.io.active
@@ -79,5 +125,5 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   io.activity.stalled  := sequencer.io.active && !issue.valid
   io.activity.inFlight := PopCount(stages.map(_.valid))
 
-  emit(atCompare.valid, atCompare.bits.iBase, atCompare.bits.jBase, atCompare.bits.laneMask, atCompare.bits.probeI, atCompare.bits.probeJ, hitMask)
+  emit(atCompare.valid, atCompare.bits.iBase, atCompare.bits.jBase, atCompare.bits.laneMask, probeI, atCompare.bits.probeJ, hitMask)
 }

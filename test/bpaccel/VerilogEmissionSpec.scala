@@ -58,6 +58,54 @@ class VerilogEmissionSpec extends AnyFlatSpec with Matchers {
     }
   }
 
+  /** The `input`/`output` declarations of `module`'s port list, as (direction, name). */
+  private def ports(text: String): Seq[(String, String)] = {
+    val list = "(?s)module\\s+\\w+\\s*\\((.*?)\\);".r.findFirstMatchIn(text).get.group(1)
+    "(?m)^\\s*(input|output)\\s*(?:\\[[^\\]]+\\])?\\s*(\\w+)".r.findAllMatchIn(list).map(x => (x.group(1), x.group(2))).toSeq
+  }
+
+  it should "give each seed memory one clock port, one read port and one write port" in {
+    val (p, dir) = emitted(4)
+    val memModule = s"mem_${p.depth}x${p.keyWidth}"
+    val declared  = ports(read(dir, s"$memModule.sv"))
+    declared.map(_._2).filter(_.contains("clk")) shouldBe empty
+    declared should contain(("input", SingleClockMemories.clockPort))
+    declared.map(_._2).filter(_.endsWith("_addr")).sorted shouldBe Seq("R0_addr", "W0_addr")
+    read(dir, "CoordBuffer.sv") should not include "_clk"
+  }
+
+  it should "give each memory a shape that Xilinx synthesis maps to block RAM out of context" in {
+    // The memory module alone, as a vendor flow synthesising it out of context would see it:
+    // with one clock the read-address register merges into the block RAM; with a clock per
+    // port (firtool's own output) Yosys 0.23 falls back to LUT RAM.
+    val (p, dir) = emitted(2)
+    val memModule = s"mem_${p.depth}x${p.keyWidth}"
+    val log = new StringBuilder
+    val exit = Process(
+      Seq("yosys", "-p", s"read_verilog -sv $memModule.sv; synth_xilinx -family xc7 -top $memModule; stat"),
+      dir.toFile
+    ).!(ProcessLogger(l => log.append(l).append('\n'), l => log.append(l).append('\n')))
+    withClue(log.toString.takeRight(3000)) {
+      exit shouldBe 0
+      "(?m)^\\s+RAMB18E1\\s+1$".r.findFirstIn(log.toString) shouldBe defined
+      "(?m)^\\s+RAM(32M|64M|128X1D)\\s+\\d+$".r.findFirstIn(log.toString) shouldBe empty
+    }
+  }
+
+  it should "refuse to merge the clocks of a memory whose ports are clocked differently" in {
+    val (p, dir) = emitted(1)
+    val coords = dir.resolve("CoordBuffer.sv")
+    // Undo the rewrite of one instance and clock its write port from another signal.
+    val broken = read(dir, "CoordBuffer.sv")
+      .replaceFirst("\\.clock\\s*\\(clock\\)", ".R0_clk (clock),\n    .W0_clk (io_readEnable)")
+    Files.writeString(coords, broken)
+    val mem = dir.resolve(s"mem_${p.depth}x${p.keyWidth}.sv")
+    Files.writeString(mem, read(dir, mem.getFileName.toString)
+      .replaceFirst(s"input\\s+${SingleClockMemories.clockPort}", "input R0_clk,\n  input W0_clk"))
+    val e = the[IllegalStateException] thrownBy SingleClockMemories.rewrite(dir)
+    e.getMessage should include("clocks its ports differently")
+  }
+
   for (m <- Seq(1, 3, 16))
     it should s"pass verilator --lint-only -Wall without a warning for the stream architecture, m=$m" in {
       lint(emitted(m, Arch.Stream, capacity = Some(1000))._2)
