@@ -33,7 +33,7 @@ BENCH_ARGS ?=
 FPGA_TEST_VERILOG := build/fpga-verilog/test-m2
 
 .PHONY: all deps test test-hw test-host test-fpga host bench verilog fpga fpga-sweep clean \
-        host-sanitize test-sanitize fuzz test-fuzz fuzz-long
+        host-sanitize test-sanitize fuzz test-fuzz fuzz-long formal-long
 
 all: test
 
@@ -47,6 +47,11 @@ test: deps test-hw test-host test-fpga test-fuzz
 # Verilog lint and memory structure.
 test-hw: deps
 	$(SBT) test
+
+# The formal checks at depths that cover a whole run of each small
+# configuration (docs/verification.md); `make test` runs shallower ones.
+formal-long: deps
+	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec"
 
 # The C++ host (build/bin/bpaccel) with the Verilated accelerator, and its tests.
 $(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps

@@ -31,6 +31,11 @@ lazy val root = (project in file("."))
     concurrentRestrictions in Global += Tags.limit(Tags.Test, 2),
     Test / fork := true,
     Test / javaOptions ++= Seq("-Xmx6g", "-Xss16m"),
+    // The deep formal checks (tag bpaccel.FormalLong) run only with BPACCEL_FORMAL_LONG set: make formal-long.
+    Test / testOptions ++= (
+      if (sys.env.contains("BPACCEL_FORMAL_LONG")) Nil
+      else Seq(Tests.Argument(TestFrameworks.ScalaTest, "-l", "bpaccel.FormalLong"))
+    ),
     Compile / run / fork := true,
     Compile / run / javaOptions ++= Seq("-Xmx6g", "-Xss16m")
   )

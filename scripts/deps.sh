@@ -10,7 +10,7 @@ debian_packages=(
   python3-venv python3-matplotlib yosys  # plots; the FPGA flow (its PyPI tools go into .venv)
   libfcl-dev libcgal-dev libode-dev      # the benchmark's peer broad phases
   libtbb-dev                             # the host's thread pool
-  z3                                     # ChiselTest formal checks
+  cvc4                                   # ChiselTest formal checks (Debian's z3 4.8.12 stalls on their encoding)
   clang libclang-rt-14-dev               # libFuzzer and the sanitizers
 )
 

@@ -35,6 +35,11 @@ object Arch {
   *                         with one, the BRAM's clock-to-out fed the rotator directly)
   * @param debugPort        add a port that shows every lane's (i, j, valid) per cycle, for tests
   * @param arch             which architecture to build (see [[Arch]])
+  * @param counterWidth     bits of each run counter (cycles, hits, ...); 64 cannot overflow
+  *                         within any run this design can hold. The formal checks narrow
+  *                         them: their runs are short and wide adders slow the solver.
+  * @param faults           deliberate bugs for the formal checks' mutant tests (see [[Fault]]);
+  *                         empty for every real build
   */
 case class AccelParams(
   m: Int = 8,
@@ -43,7 +48,9 @@ case class AccelParams(
   resultQueueDepth: Int = 16,
   memoryOutputStages: Int = 2,
   debugPort: Boolean = false,
-  arch: Arch = Arch.Seed
+  arch: Arch = Arch.Seed,
+  counterWidth: Int = 64,
+  faults: Set[Fault] = Set.empty
 ) {
   require(m >= 1, s"parallelism m must be at least 1, got m = $m")
   require(capacity >= 2, s"capacity must be at least 2 objects, got capacity = $capacity")
@@ -56,6 +63,7 @@ case class AccelParams(
     s"memoryOutputStages must lie in 0..4, got $memoryOutputStages"
   )
   require(keyWidth >= 1 && keyWidth <= 64, s"keyWidth must lie in 1..64, got keyWidth = $keyWidth")
+  require(counterWidth >= 1 && counterWidth <= 64, s"counterWidth must lie in 1..64, got counterWidth = $counterWidth")
   require(m < (1 << 16) && capacity.toLong < (1L << 32), s"m must fit 16 bits and capacity 32 bits, got m = $m, capacity = $capacity")
 
   /** Rows of each of the m striped memories of the seed architecture. */
@@ -116,8 +124,8 @@ case class AccelParams(
       s"so a consumer that is always ready never stalls the schedule, got $resultQueueDepth"
   )
 
-  /** Width of a counter; 64 bits cannot overflow within any run this design can hold. */
-  val counterWidth: Int = 64
+  /** Whether the mutant tests asked for this deliberate bug. */
+  def has(fault: Fault): Boolean = faults.contains(fault)
 }
 
 object AccelParams {

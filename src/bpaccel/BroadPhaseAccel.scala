@@ -57,7 +57,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   // queue count + cycles in flight grows by at most one a cycle, so room for
   // one more last cycle means room now.
   engine.io.advance := RegNext(
-    queue.io.count +& engine.io.activity.inFlight +& 1.U < p.resultQueueDepth.U,
+    queue.io.count +& engine.io.activity.inFlight +& 1.U < creditedEntries.U,
     false.B
   )
   control.io.engine := engine.io.activity
@@ -67,6 +67,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   queue.io.enq.bits  := beat.bits
   assert(!queue.io.enq.valid || queue.io.enq.ready, "result queue overflow: credit accounting is broken")
   io.result <> queue.io.deq
+  if (p.has(Fault.DropBeatWhenNotReady)) queue.io.deq.ready := true.B
 
   // The popcount gets its own register: at m = 32 popcount + 64-bit add was
   // the critical path (80.7 MHz). The count still lands by the time done
@@ -85,4 +86,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   io.info.readLatency       := (if (p.arch == Arch.Stream) p.readLatency else 0).U
 
   io.debug.foreach(_ := engine.io.probe.get)
+
+  /** Result-queue entries the credit check counts on (one too many with that mutant's fault). */
+  private def creditedEntries: Int = p.resultQueueDepth + (if (p.has(Fault.CreditOneTooMany)) 1 else 0)
 }

@@ -71,7 +71,7 @@ class RunControl(p: AccelParams) extends Module {
       )
     )
     error := code
-    val runs = code === AccelError.None && n >= 2.U
+    val runs = (if (p.has(Fault.ErrorStartLaunches)) true.B else code === AccelError.None) && n >= 2.U
     busy            := runs
     done            := !runs
     io.launch.valid := runs
@@ -98,7 +98,8 @@ class RunControl(p: AccelParams) extends Module {
       }.otherwise {
         drainCycles := drainCycles + 1.U
       }
-      when(io.engine.inFlight === 0.U && io.queueEmpty) {
+      val drained = if (p.has(Fault.DoneBeforeQueueEmpty)) true.B else io.queueEmpty
+      when(io.engine.inFlight === 0.U && drained) {
         busy := false.B
         done := true.B
       }
@@ -108,6 +109,7 @@ class RunControl(p: AccelParams) extends Module {
   // the consumer put the queue's read multiplexer, a popcount and a 64-bit add
   // on one path. Every queued beat is delivered before done rises.
   when(io.queuedHits.valid) { hits := hits + io.queuedHits.bits }
+  if (p.has(Fault.DoneClearedByLoad)) when(io.loadFire) { done := false.B }
 
   io.status.busy  := busy
   // A box beyond the capacity shows at once; the next start fails with it.

@@ -173,7 +173,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     left      := count - 2.U
     blockLeft := count - 2.U
     blockEnd     := count === 2.U
-    hasNextBlock := count >= (m + 2).U
+    hasNextBlock := count >= (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 3 else 2)).U
     capture   := 1.U
     rBase      := 0.U
     rBlockLeft := count - 2.U
@@ -196,7 +196,8 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val meta = Wire(new Meta)
   meta.iBase    := base
   meta.jBase    := s
-  meta.laneMask := VecInit(Seq.tabulate(m)(k => remaining > k.U)).asUInt
+  meta.laneMask := VecInit(Seq.tabulate(m)(k =>
+    if (p.has(Fault.LaneMaskOneTooWide)) remaining >= k.U else remaining > k.U)).asUInt
   if (p.debugPort) {
     // The objects each lane really holds, from the tags that travelled with the data.
     meta.probeI := VecInit(a.map(_.tag))
@@ -209,7 +210,10 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // Six comparator results per lane, registered before the AND.
   val compared = RegNext(VecInit(a.zip(window).map { case (ea, eb) =>
     val (x, y) = (boxOf(ea), boxOf(eb))
-    VecInit((0 until 3).flatMap(axis => Seq(x.min(axis) <= y.max(axis), x.max(axis) >= y.min(axis)))).asUInt
+    VecInit((0 until 3).flatMap(axis =>
+      if (p.has(Fault.StrictCompare)) Seq(x.min(axis) < y.max(axis), x.max(axis) > y.min(axis))
+      else Seq(x.min(axis) <= y.max(axis), x.max(axis) >= y.min(axis))
+    )).asUInt
   }))
   val atCompare = Pipe(issue, meta)
   val hitMask   = RegNext(VecInit(compared.map(_.andR)).asUInt & atCompare.bits.laneMask)
@@ -221,5 +225,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   io.activity.stalled  := issuing && !io.advance
   io.activity.inFlight := atCompare.valid.asUInt +& atAnd.valid.asUInt
 
-  emit(atAnd.valid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, atAnd.bits.probeI, atAnd.bits.probeJ, hitMask)
+  val outValid =
+    if (p.has(Fault.RepeatLastBeat)) atAnd.valid || (RegNext(atAnd.valid, false.B) && !atAnd.valid) else atAnd.valid
+  emit(outValid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, atAnd.bits.probeI, atAnd.bits.probeJ, hitMask)
 }

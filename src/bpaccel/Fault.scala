@@ -1,0 +1,42 @@
+package bpaccel
+
+/** Deliberate design faults, one bug each, for the formal checks' mutant
+  * tests (test/bpaccel/FormalSpec.scala): each property must fail on the
+  * fault it is meant to catch, so a passing proof is not vacuous. Only
+  * [[AccelParams.faults]] turns one on; the default (no fault) elaborates to
+  * exactly the design without them.
+  */
+sealed abstract class Fault(val description: String)
+
+object Fault {
+  /** The credit check believes the result queue has one more entry than it has. */
+  case object CreditOneTooMany extends Fault("credit check counts one result-queue entry too many")
+  /** The result queue lets a beat go when the consumer is not ready: it is lost. */
+  case object DropBeatWhenNotReady extends Fault("result queue dequeues while the consumer is not ready")
+  /** A run ends once the engine is idle, without waiting for the queued beats. */
+  case object DoneBeforeQueueEmpty extends Fault("done rises before the result queue is empty")
+  /** Loading a box after a run clears `done` although no run started. */
+  case object DoneClearedByLoad extends Fault("a load after a run clears done")
+  /** A start with an error still launches the engine. */
+  case object ErrorStartLaunches extends Fault("a start with an error launches the engine")
+  /** Lane k is compared while k more objects remain instead of more than k: its partner is object n. */
+  case object LaneMaskOneTooWide extends Fault("lane mask lets a lane compare one object past the last")
+  /** The AND stage sends its last beat again in the cycle after it. */
+  case object RepeatLastBeat extends Fault("the last beat before a gap is sent twice")
+  /** A run of m+2 objects skips its second block: its pairs are never tested. */
+  case object SkipSecondBlockAtMPlus2 extends Fault("a run of m+2 objects skips its second block")
+  /** The comparators test min < max instead of min <= max: touching boxes are missed. */
+  case object StrictCompare extends Fault("comparators miss touching boxes")
+
+  val all: Seq[Fault] = Seq(
+    CreditOneTooMany,
+    DropBeatWhenNotReady,
+    DoneBeforeQueueEmpty,
+    DoneClearedByLoad,
+    ErrorStartLaunches,
+    LaneMaskOneTooWide,
+    RepeatLastBeat,
+    SkipSecondBlockAtMPlus2,
+    StrictCompare
+  )
+}

@@ -1,0 +1,156 @@
+package bpaccel
+
+import chisel3._
+import chisel3.util._
+
+/** A group of properties the [[FormalHarness]] asserts; each has its own
+  * assertion messages, so a failing check names the group that caught it.
+  */
+sealed abstract class Property(val name: String)
+object Property {
+  /** The result queue never holds more than its depth, and hands the consumer
+    * exactly the beats that entered it, each once, in order, whatever `ready` does.
+    */
+  case object ExactlyOnce extends Property("exactly-once")
+  /** `done` means every beat was taken and none will come; it stays until the next start. */
+  case object Done extends Property("done")
+  /** A start with an error (or fewer than two objects) ends at once with its code and no beat. */
+  case object ErrorStart extends Property("error-start")
+  /** Each lane compares i < j < n, and the beats of a run are distinct pairs. */
+  case object Lanes extends Property("lanes")
+  /** A run tests n(n-1)/2 pairs (with [[Lanes]]: all of them), and each hit bit is the overlap of boxes i and j. */
+  case object Pairs extends Property("pairs")
+
+  val all: Seq[Property] = Seq(ExactlyOnce, Done, ErrorStart, Lanes, Pairs)
+}
+
+/** Formal-only wrapper: the accelerator with every input free (boxes, start
+  * counts, load/start/ready timing) and monitors that assert `properties`.
+  * The monitors see only the top level's ports, with the debug port's
+  * per-lane view of what the comparators hold (tags that travelled with the
+  * boxes); they keep their own model of what was loaded and what entered the
+  * result queue, independent of the design's registers.
+  */
+class FormalHarness(p: AccelParams, properties: Set[Property] = Property.all.toSet) extends Module {
+  require(p.debugPort, "the formal checks watch the lanes through the debug port")
+  val io = IO(new Bundle {
+    val load   = Flipped(Decoupled(new Aabb(p.keyWidth)))
+    val start  = Flipped(Decoupled(UInt(p.countWidth.W)))
+    val result = Decoupled(new ResultBeat(p))
+  })
+  private val m     = p.m
+  private val depth = p.resultQueueDepth
+
+  val dut = Module(new BroadPhaseAccel(p))
+  dut.io.load <> io.load
+  dut.io.start <> io.start
+  io.result <> dut.io.result
+  private val status = dut.io.status
+  private val lanes  = dut.io.debug.get.lanes
+  private val cycle  = dut.io.debug.get.cycleValid // a schedule cycle leaves the AND stage
+
+  private def check(property: Property, cond: Bool, what: String): Unit =
+    if (properties.contains(property)) assert(cond, s"[${property.name}] $what")
+
+  // ---- what the consumer has asked for: loads and starts ----
+  // Boxes of the run being loaded, numbered as the protocol says: from 0 after each start.
+  val loaded = RegInit(0.U(log2Ceil(p.capacity + 2).W)) // saturates at capacity + 1: overflow
+  val boxes  = Reg(Vec(p.capacity, new Aabb(p.keyWidth)))
+  when(io.load.fire) {
+    when(loaded < p.capacity.U) { boxes(loaded(p.indexWidth - 1, 0)) := io.load.bits }
+    when(loaded <= p.capacity.U) { loaded := loaded + 1.U }
+  }
+  val n         = Reg(UInt(p.countWidth.W))
+  val goodRun   = RegInit(false.B) // the last start launched a run of n >= 2 objects
+  val quietRun  = RegInit(false.B) // the last start had an error or n < 2: nothing may be compared
+  val startCode = Wire(AccelError())
+  startCode := MuxCase(
+    AccelError.None,
+    Seq(
+      (loaded > p.capacity.U)      -> AccelError.LoadOverflow,
+      (io.start.bits > p.capacity.U) -> AccelError.CountOverCapacity,
+      (io.start.bits > loaded)     -> AccelError.CountOverLoaded
+    )
+  )
+  val startedQuiet = RegNext(io.start.fire && (startCode =/= AccelError.None || io.start.bits < 2.U), false.B)
+  val quietCode    = RegNext(startCode)
+  when(io.start.fire) {
+    loaded   := 0.U
+    n        := io.start.bits
+    goodRun  := startCode === AccelError.None && io.start.bits >= 2.U
+    quietRun := !(startCode === AccelError.None && io.start.bits >= 2.U)
+  }
+
+  // ---- a model of the result queue: the beats that entered it and were not yet taken ----
+  val hitMask  = VecInit(lanes.map(_.hit)).asUInt
+  val entering = Wire(new ResultBeat(p))
+  entering.iBase := lanes(0).i
+  entering.jBase := lanes(0).j
+  entering.mask  := hitMask
+  val enters  = cycle && hitMask.orR
+  val slots   = depth + 1 // one more than the queue, so the model itself never overflows
+  val held    = Reg(Vec(slots, new ResultBeat(p)))
+  val head    = RegInit(0.U(log2Ceil(slots).W))
+  val tail    = RegInit(0.U(log2Ceil(slots).W))
+  val count   = RegInit(0.U(log2Ceil(slots + 1).W))
+  private def wrap(x: UInt): UInt = Mux(x === (slots - 1).U, 0.U, x + 1.U)
+  when(enters) { held(tail) := entering; tail := wrap(tail) }
+  when(io.result.fire) { head := wrap(head) }
+  count := count + enters.asUInt - io.result.fire.asUInt
+
+  check(Property.ExactlyOnce, count <= depth.U, "the result queue holds more beats than its depth")
+  check(Property.ExactlyOnce, io.result.valid === (count =/= 0.U || enters),
+    "result.valid differs from 'a beat entered and was not taken'")
+  check(Property.ExactlyOnce, !io.result.valid || io.result.bits.asUInt === Mux(count === 0.U, entering, held(head)).asUInt,
+    "the beat offered is not the oldest one not yet taken")
+
+  // ---- done ----
+  check(Property.Done, !status.done || (!status.busy && count === 0.U && !io.result.valid && !cycle),
+    "done while a beat is queued, offered or still in the pipeline")
+  val wasDone = RegNext(status.done, false.B)
+  val started = RegNext(io.start.fire, false.B)
+  check(Property.Done, !wasDone || started || status.done, "done fell without a start")
+
+  // ---- error starts ----
+  check(Property.ErrorStart, !(quietRun || startedQuiet) || (!cycle && !io.result.valid),
+    "a start with an error or fewer than two objects produced a beat")
+  check(Property.ErrorStart, !startedQuiet || (status.done && !status.busy && status.error === quietCode),
+    "a start with an error or fewer than two objects did not end at once with its code")
+
+  // ---- lanes: i < j < n, and the run's pairs are distinct ----
+  for (k <- 0 until m) {
+    val lane = lanes(k)
+    check(Property.Lanes, !lane.valid || cycle, "a lane is valid outside a schedule cycle")
+    check(Property.Lanes, !(cycle && lane.hit) || lane.valid, "a lane hits without a comparison")
+    check(Property.Lanes, !lane.valid || (lane.i < lane.j && lane.j < n), "a lane compares i >= j or j >= n")
+    check(Property.Lanes, !lane.valid || (lane.i === lanes(0).i + k.U && lane.j === lanes(0).j + k.U),
+      "lane k does not hold objects iBase + k and jBase + k")
+  }
+  check(Property.Lanes, !cycle || (lanes(0).valid && goodRun), "a schedule cycle without lane 0 or outside a run")
+  // Beats (iBase, jBase) rise strictly, iBase a multiple of m: then pair (iBase + k, jBase + k)
+  // names its beat and lane, so no pair is tested twice.
+  check(Property.Lanes, !cycle || lanes(0).i % m.U === 0.U, "iBase is not a multiple of m")
+  val seen  = RegInit(false.B)
+  val lastI = Reg(UInt(p.indexWidth.W))
+  val lastJ = Reg(UInt(p.indexWidth.W))
+  check(Property.Lanes,
+    !(cycle && seen) || lanes(0).i > lastI || (lanes(0).i === lastI && lanes(0).j > lastJ),
+    "a beat's (iBase, jBase) does not follow the previous one's: a pair may repeat")
+  when(cycle) { seen := true.B; lastI := lanes(0).i; lastJ := lanes(0).j }
+  when(io.start.fire) { seen := false.B }
+
+  // ---- pairs: all n(n-1)/2 tested, each hit bit right ----
+  val pairWidth = log2Ceil(p.capacity * (p.capacity - 1) / 2 + 1) + 1
+  val tested    = RegInit(0.U(pairWidth.W))
+  when(cycle) { tested := tested + PopCount(lanes.map(_.valid)) }
+  when(io.start.fire) { tested := 0.U }
+  val allPairs = (n * (n - 1.U)) >> 1
+  check(Property.Pairs, !(status.done && goodRun) || tested === allPairs,
+    "a run ended without testing n(n-1)/2 pairs")
+  private def overlap(x: Aabb, y: Aabb): Bool =
+    (0 until 3).map(a => x.min(a) <= y.max(a) && y.min(a) <= x.max(a)).reduce(_ && _)
+  for (lane <- lanes) {
+    check(Property.Pairs, !(lane.valid && lane.j < p.capacity.U) || lane.hit === overlap(boxes(lane.i), boxes(lane.j)),
+      "a hit bit is not the overlap of the loaded boxes i and j")
+  }
+}
