@@ -146,9 +146,12 @@ class FormalSpec extends AnyFlatSpec with ChiselScalatestTester with Formal with
   private val combinedPortMessage = "Combined read/write ports are currently not supported"
   private def causes(e: Throwable): Seq[Throwable] = Iterator.iterate(e)(_.getCause).takeWhile(_ != null).take(20).toSeq
 
-  it should "keep every property for m=1, capacity=2 over a whole run once ChiselTest accepts its memories" in {
+  // The seed's memories used to have one combined read/write port each, which
+  // ChiselTest's formal backend rejects; they now have separate ports. The
+  // cancel stays for a generator change that brings one back.
+  private def proveSeed(name: String, depth: Int): Unit = {
     val p = params(Arch.Seed, 1, 2)
-    try prove("seed-m1-c2", p, runCycles(p, 2) - 1 + 2)
+    try prove(name, p, depth)
     catch {
       case e: Throwable if causes(e).exists(c => Option(c.getMessage).exists(_.contains(combinedPortMessage))) =>
         cancel(
@@ -156,5 +159,14 @@ class FormalSpec extends AnyFlatSpec with ChiselScalatestTester with Formal with
             s"port each): \"$combinedPortMessage\""
         )
     }
+  }
+
+  it should "keep every property for m=1, capacity=2 over 5 cycles" in {
+    proveSeed("seed-m1-c2-k5", 5)
+  }
+
+  it should "keep every property for m=1, capacity=2 over a whole run" taggedAs FormalLong in {
+    val p = params(Arch.Seed, 1, 2)
+    proveSeed("seed-m1-c2", runCycles(p, 2) - 1 + 2)
   }
 }
