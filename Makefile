@@ -77,7 +77,7 @@ bench: host
 # of every method still validated, a few frames a row. Methods whose set-up or
 # sweep cannot be stopped midway are skipped with their reason where they would
 # take many minutes (docs/results.md); --max-method-seconds stops the others.
-BENCH_LARGE_ARGS ?= --objects 100000 1000000 --backend model --frames 3 --warmup 1
+BENCH_LARGE_ARGS ?= --objects 100000 1000000 --backend model --frames 3 --warmup 1 --whole-step-objects 0
 .PHONY: bench-large
 bench-large: host
 	mkdir -p results/large; set -o pipefail; build/bin/bpaccel bench --json results/large/bench.json $(BENCH_LARGE_ARGS) | tee results/large/bench.txt
