@@ -218,12 +218,11 @@ void BroadPhase::Worker::runBatch(std::span<const KeyBox> keys, std::span<const 
     for (std::size_t t = 0; t < items.size(); ++t) gathered[t] = keys[items[t]];
     packed = gathered;
   }
-  const std::span<const KeyBox> batch = packed;
   local.clear();
   RunRecord record;
   const auto ready = Clock::now();
   record.readySeconds = seconds(frameStart, ready) - backendSeconds;
-  backend->run(batch, local, record.stats);
+  backend->run(packed, local, record.stats);
   const auto ran = Clock::now();
   backendSeconds += seconds(ready, ran);
   stats += record.stats;
@@ -231,7 +230,7 @@ void BroadPhase::Worker::runBatch(std::span<const KeyBox> keys, std::span<const 
     const bool firstA = a < splitAt, firstB = b < splitAt;
     const int kind = firstA != firstB ? kCross : (firstA ? kFirstInside : kSecondInside);
     if (!(keep & kind)) continue;
-    if (region && !region->contains(referencePoint(batch[a], batch[b]))) continue;
+    if (region && !region->contains(referencePoint(packed[a], packed[b]))) continue;
     const std::uint32_t i = items[a], j = items[b];
     out.emplace_back(std::min(i, j), std::max(i, j));
   }

@@ -72,11 +72,11 @@ BulletBroadphase::BulletBroadphase(Kind kind, std::span<const Aabb> initial, flo
 
 // btDbvtBroadphase allocates every proxy and frees it only in destroyProxy
 // (LeakSanitizer reports the rest), so its proxies are destroyed first, after
-// its pairs (removeAllOverlappingPairs says why). The
-// sweep (built without a raycast accelerator) and the simple broad phase keep
-// their proxies in arrays they free themselves; destroying them one by one
-// would cost the sweep O(n^2) (each removal moves its edges to the end of
-// every axis). No pair holds a collision algorithm: nothing was dispatched.
+// its pairs (removeAllOverlappingPairs says why). The sweep (built without a
+// raycast accelerator) and the simple broad phase keep their proxies in
+// arrays they free themselves; destroying them one by one would cost the
+// sweep O(n^2) (each removal moves its edges to the end of every axis). No
+// pair holds a collision algorithm: nothing was dispatched.
 BulletBroadphase::~BulletBroadphase() {
   if (kind_ != Kind::Dbvt) return;
   removeAllOverlappingPairs(*broadphase_->getOverlappingPairCache(), dispatcher_.get());

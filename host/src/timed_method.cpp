@@ -1,7 +1,7 @@
 #include "timed_method.hpp"
 
 #include <algorithm>
-#include <numeric>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -30,19 +30,15 @@ SkipRule allPairsSkipReason(double maxTestsPerFrame) {
 }
 
 std::uint64_t pairsOverlappingOnX(std::span<const Aabb> boxes) {
-  std::vector<float> mins(boxes.size());
-  std::transform(boxes.begin(), boxes.end(), mins.begin(), [](const Aabb& b) { return b.min[0]; });
-  std::vector<std::uint32_t> byMin(boxes.size());
-  std::iota(byMin.begin(), byMin.end(), 0u);
-  std::sort(byMin.begin(), byMin.end(), [&](std::uint32_t a, std::uint32_t b) { return mins[a] < mins[b]; });
-  std::sort(mins.begin(), mins.end());
+  std::vector<std::pair<float, float>> xs(boxes.size());  // (min x, max x), sorted by min x
+  std::transform(boxes.begin(), boxes.end(), xs.begin(), [](const Aabb& b) { return std::pair(b.min[0], b.max[0]); });
+  std::ranges::sort(xs, {}, &std::pair<float, float>::first);
   // Each pair once: counted at the box that comes first in order of min x,
   // against every later box whose min x is not beyond its max x.
   std::uint64_t pairs = 0;
-  for (std::size_t p = 0; p < mins.size(); ++p) {
-    const auto end = std::upper_bound(mins.begin() + static_cast<std::ptrdiff_t>(p) + 1, mins.end(),
-                                      boxes[byMin[p]].max[0]);
-    pairs += static_cast<std::uint64_t>(end - mins.begin()) - p - 1;
+  for (auto it = xs.begin(); it != xs.end(); ++it) {
+    const auto end = std::ranges::upper_bound(it + 1, xs.end(), it->second, {}, &std::pair<float, float>::first);
+    pairs += static_cast<std::uint64_t>(end - it - 1);
   }
   return pairs;
 }

@@ -71,13 +71,7 @@ TEST(BroadPhase, DegenerateScenesFallBackToChunkedLeaves) {
 
 TEST(KdTree, LeavesRespectTheCellSizeWhenSplitsExistAndPartitionSpace) {
   // Small boxes spread thinly: planes rarely cut them, so every cell can split down.
-  std::mt19937 gen(3);
-  std::uniform_real_distribution<float> pos(-100, 100), ext(0, 0.5f);
-  std::vector<Aabb> boxes(2000);
-  for (auto& b : boxes) {
-    const float x = pos(gen), y = pos(gen), z = pos(gen);
-    b = box(x, y, z, x + ext(gen), y + ext(gen), z + ext(gen));
-  }
+  const std::vector<Aabb> boxes = scatteredBoxes(2000, 3, -100, 100, 0, 0.5f);
   std::vector<KeyBox> keys;
   toKeys(boxes, keys);
   KdTree tree;
@@ -324,13 +318,7 @@ TEST(BroadPhase, CellsReachTheBackendWhileTheTreeIsStillBeingBuilt) {
   LeafCountingBackend counting(model, phase);
   BroadPhase bp(counting, 16);
   phase = &bp;
-  std::mt19937 gen(9);
-  std::uniform_real_distribution<float> pos(-40, 40), ext(0, 2);
-  std::vector<Aabb> boxes(2000);
-  for (auto& b : boxes) {
-    const float x = pos(gen), y = pos(gen), z = pos(gen);
-    b = box(x, y, z, x + ext(gen), y + ext(gen), z + ext(gen));
-  }
+  const std::vector<Aabb> boxes = scatteredBoxes(2000, 9, -40, 40, 0, 2);
   std::vector<Pair> pairs;
   bp.findPairs(boxes, pairs);
   const std::size_t leaves = bp.tree().leaves().size();
@@ -394,15 +382,9 @@ TEST(KdTree, CarriedAndGatheredLayoutsGiveTheSameLeavesAndPackedBoxes) {
 
 TEST(BroadPhase, ScenesLargerThanTheCarryThresholdAreExactOnOneAndTwoThreads) {
   // Above KdTree::kCarryAbove the tree carries boxes and hands cells over packed.
-  std::mt19937 gen(5);
   const std::size_t n = KdTree::kCarryAbove + 1000;
   const float edge = std::cbrt(static_cast<float>(n) / 0.05f);
-  std::uniform_real_distribution<float> pos(0, edge), ext(0.5f, 2);
-  std::vector<Aabb> boxes(n);
-  for (auto& b : boxes) {
-    const float x = pos(gen), y = pos(gen), z = pos(gen);
-    b = box(x, y, z, x + ext(gen), y + ext(gen), z + ext(gen));
-  }
+  const std::vector<Aabb> boxes = scatteredBoxes(n, 5, 0, edge, 0.5f, 2);
   std::vector<Pair> exact, pairs;
   exactPairs(boxes, exact);
   CpuBackend cpu;

@@ -33,6 +33,20 @@ inline std::vector<Pair> sorted(std::vector<Pair> p) {
 
 inline Aabb box(float x0, float y0, float z0, float x1, float y1, float z1) { return {{x0, y0, z0}, {x1, y1, z1}}; }
 
+/// n boxes scattered uniformly: min corner in [lo, hi) on each axis, each
+/// extent in [extentLo, extentHi).
+inline std::vector<Aabb> scatteredBoxes(std::size_t n, unsigned seed, float lo, float hi, float extentLo,
+                                        float extentHi) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<float> pos(lo, hi), ext(extentLo, extentHi);
+  std::vector<Aabb> boxes(n);
+  for (auto& b : boxes) {
+    const float x = pos(gen), y = pos(gen), z = pos(gen);
+    b = box(x, y, z, x + ext(gen), y + ext(gen), z + ext(gen));
+  }
+  return boxes;
+}
+
 /// Named scenes that stress exactness.
 inline std::vector<std::pair<std::string, std::vector<Aabb>>> adversarialScenes(std::size_t n, unsigned seed) {
   std::mt19937 rng(seed);
