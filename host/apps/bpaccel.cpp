@@ -86,26 +86,6 @@ int runPairs(const std::string& input, const std::string& backendName, const std
   return 0;
 }
 
-// Default clock: the Fmax the FPGA flow measured for this configuration, if it ran.
-std::pair<double, std::string> defaultClock(const std::string& fpgaReport) {
-  std::ifstream in(fpgaReport);
-  if (!in) return {100e6, "default 100 MHz (no FPGA report at " + fpgaReport + ")"};
-  try {
-    const auto j = nlohmann::json::parse(in);
-    if (j.at("status") != "ok" || !j.at("result_valid").get<bool>())
-      return {100e6, "default 100 MHz (" + fpgaReport + " holds no valid result)"};
-    if (j.at("m").get<int>() != BPACCEL_M)
-      return {100e6, fmt::format("default 100 MHz ({} is for m = {}, not {})", fpgaReport, j.at("m").get<int>(),
-                                 BPACCEL_M)};
-    const double mhz = j.at("ecp5").at("fmax_mhz").get<double>();
-    if (mhz > 0)
-      return {mhz * 1e6, fmt::format("Fmax {:.2f} MHz measured by nextpnr on ECP5 ({})", mhz, fpgaReport)};
-  } catch (const std::exception& e) {
-    fmt::print(stderr, "bpaccel: ignoring FPGA report {}: {}\n", fpgaReport, e.what());
-  }
-  return {100e6, "default 100 MHz (" + fpgaReport + " unreadable)"};
-}
-
 // The device the accelerator methods model: this program's Verilated configuration.
 std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, double clockMHz,
                                                   const std::string& fpgaReport, double linkGBytesPerSecond,
@@ -123,7 +103,9 @@ std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, do
     device->clockHz = clockMHz * 1e6;
     device->clockSource = fmt::format("--clock-mhz {}", clockMHz);
   } else {
-    std::tie(device->clockHz, device->clockSource) = defaultClock(fpgaReport);
+    auto clock = bpaccel::clockFromFpgaReport(fpgaReport, BPACCEL_M, BPACCEL_ARCH);
+    device->clockHz = clock.hz;
+    device->clockSource = std::move(clock.source);
   }
   device->link.bandwidthBytesPerSecond = linkGBytesPerSecond * 1e9;
   device->link.latencySecondsPerRun = linkLatencyUs * 1e-6;
@@ -201,7 +183,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> benchCells = {"none", "16", "32", "64", "128", "256"};
   std::string benchBackend = "rtl", benchJson = "results/bench.json";
   double clockMHz = 0, linkGBytesPerSecond = 4, linkLatencyUs = 1;
-  std::string fpgaReport = fmt::format("results/fpga/m{}.json", BPACCEL_M);
+  // The FPGA flow's report names: m<m>.json for the seed architecture, <arch>-m<m>.json otherwise.
+  std::string fpgaReport = BPACCEL_ARCH_STREAM ? fmt::format("results/fpga/stream-m{}.json", BPACCEL_M)
+                                               : fmt::format("results/fpga/m{}.json", BPACCEL_M);
   auto* benchCmd = app.add_subcommand(
       "bench", "Bouncing-cube benchmark: Bullet's, FCL's, CGAL's and ODE's broad phases against the accelerator");
   auto addSceneOptions = [](CLI::App* cmd, bpaccel::SceneConfig& sc) {

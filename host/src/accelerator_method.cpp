@@ -1,6 +1,7 @@
 #include "accelerator_method.hpp"
 
 #include <algorithm>
+#include <fstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -80,6 +81,26 @@ std::vector<MethodSpec> threadedCpuMethods(const std::vector<std::optional<std::
 std::vector<MethodSpec> cpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, double maxAllPairsTests) {
   return perCellSize("cpu", MethodKind::Cpu, cellSizes, maxAllPairsTests,
                      [](std::optional<std::size_t> c) { return std::make_unique<CpuMethod>(c); });
+}
+
+DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std::string& arch) {
+  const auto fallback = [](std::string why) { return DeviceClock{100e6, "default 100 MHz (" + std::move(why) + ")"}; };
+  std::ifstream in(fpgaReport);
+  if (!in) return fallback("no FPGA report at " + fpgaReport);
+  try {
+    const auto j = nlohmann::json::parse(in);
+    if (j.at("status") != "ok" || !j.at("result_valid").get<bool>())
+      return fallback(fpgaReport + " holds no valid result");
+    if (const int reportM = j.at("m").get<int>(); reportM != m)
+      return fallback(fmt::format("{} is for m = {}, not {}", fpgaReport, reportM, m));
+    if (const auto reportArch = j.value("arch", std::string("seed")); reportArch != arch)
+      return fallback(fmt::format("{} is for arch = {}, not {}", fpgaReport, reportArch, arch));
+    const double mhz = j.at("ecp5").at("fmax_mhz").get<double>();
+    if (mhz > 0) return {mhz * 1e6, fmt::format("Fmax {:.2f} MHz measured by nextpnr on ECP5 ({})", mhz, fpgaReport)};
+    return fallback(fpgaReport + " has no positive Fmax");
+  } catch (const std::exception& e) {
+    return fallback(fmt::format("{} unreadable: {}", fpgaReport, e.what()));
+  }
 }
 
 }  // namespace bpaccel

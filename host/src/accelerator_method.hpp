@@ -30,6 +30,19 @@ struct LinkModel {
   double seconds(const RunStats& s, std::size_t bytesPerBeat, double clockHz) const;
 };
 
+/// A device clock and where it came from, for the table's legend.
+struct DeviceClock {
+  double hz = 100e6;
+  std::string source = "default 100 MHz";
+};
+
+/// The default clock of a device with m lanes of architecture `arch`: the Fmax
+/// that the FPGA flow's report at `fpgaReport` measured, if that report is a
+/// valid result for the same m and architecture; otherwise 100 MHz, with the
+/// reason in `source`. Reports without "arch" predate the stream architecture
+/// and are the seed's.
+DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std::string& arch);
+
 /// The device the accelerator methods model, given at run time by the program
 /// that links a hardware configuration (the benchmark library links none).
 struct DeviceConfig {

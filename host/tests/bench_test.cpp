@@ -399,6 +399,46 @@ TEST(AcceleratorMethod, DeviceTimeCountsLoadCycles) {
   EXPECT_GT(t.parts->stats.cycles, 0u);
 }
 
+TEST(DeviceClock, TheDefaultClockIsTheFmaxOfAReportOfTheSameMAndArchitectureOnly) {
+  const auto dir = std::filesystem::temp_directory_path() / ("bpaccel-clock-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& name, const nlohmann::json& j) {
+    const auto path = (dir / name).string();
+    std::ofstream(path) << j.dump();
+    return path;
+  };
+  const nlohmann::json seed8 = {
+      {"status", "ok"}, {"result_valid", true}, {"m", 8}, {"arch", "seed"}, {"ecp5", {{"fmax_mhz", 107.5}}}};
+  const auto ok = clockFromFpgaReport(write("seed8.json", seed8), 8, "seed");
+  EXPECT_DOUBLE_EQ(ok.hz, 107.5e6);
+  EXPECT_NE(ok.source.find("measured by nextpnr"), std::string::npos) << ok.source;
+
+  // The other architecture's report at the same m must not set the clock.
+  const auto otherArch = clockFromFpgaReport(write("seed8.json", seed8), 8, "stream");
+  EXPECT_DOUBLE_EQ(otherArch.hz, 100e6);
+  EXPECT_NE(otherArch.source.find("arch = seed, not stream"), std::string::npos) << otherArch.source;
+
+  auto noArch = seed8;
+  noArch.erase("arch");  // reports older than the stream architecture are the seed's
+  EXPECT_DOUBLE_EQ(clockFromFpgaReport(write("old.json", noArch), 8, "seed").hz, 107.5e6);
+  EXPECT_DOUBLE_EQ(clockFromFpgaReport(write("old.json", noArch), 8, "stream").hz, 100e6);
+
+  const auto otherM = clockFromFpgaReport(write("seed8.json", seed8), 16, "seed");
+  EXPECT_DOUBLE_EQ(otherM.hz, 100e6);
+  EXPECT_NE(otherM.source.find("m = 8, not 16"), std::string::npos) << otherM.source;
+
+  auto notFit = seed8;
+  notFit["status"] = "does_not_fit";
+  EXPECT_DOUBLE_EQ(clockFromFpgaReport(write("nofit.json", notFit), 8, "seed").hz, 100e6);
+  std::ofstream(dir / "broken.json") << "{ not json";
+  const auto broken = clockFromFpgaReport((dir / "broken.json").string(), 8, "seed");
+  EXPECT_DOUBLE_EQ(broken.hz, 100e6);
+  EXPECT_NE(broken.source.find("unreadable"), std::string::npos) << broken.source;
+  EXPECT_NE(clockFromFpgaReport((dir / "missing.json").string(), 8, "seed").source.find("no FPGA report"),
+            std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
 namespace {
 
 // Runs the real bpaccel binary; returns its exit code and standard output.
