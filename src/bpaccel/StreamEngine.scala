@@ -65,22 +65,34 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     new Queue(new Entry, p.readLatency + 2, flow = true, hasFlush = true)
   )
   val readsInFlight = Wire(UInt(log2Ceil(p.readLatency + 1).W))
-  val readEvent =
-    (starting || issuing) && readQueue.io.count +& readsInFlight < (p.readLatency + 2).U
+  // Queue slots not yet taken or claimed by a read in flight, kept as a
+  // register: comparing the queue's count plus the reads in flight with its
+  // depth put the queue pointers, an adder and a comparator in front of every
+  // reader register (the m = 8 critical path).
+  private val readDepth = p.readLatency + 2
+  val readCredits = RegInit(readDepth.U(log2Ceil(readDepth + 1).W))
+  val readEvent   = (starting || issuing) && readCredits =/= 0.U
+  readCredits := readCredits - readEvent.asUInt + issue.asUInt
   val rObj       = Reg(UInt(p.indexWidth.W))  // object read at the next read event
   val rLeft      = Reg(UInt(p.countWidth.W))  // objects after rObj in its block's stream
   val rBlockLeft = Reg(UInt(p.countWidth.W))  // n-2-base of rObj's block
   val rBase      = Reg(UInt(p.countWidth.W))
+  // The stream's tests, one read ahead as the schedule's are: rLeft == 0, rBlockLeft >= m.
+  val rBlockEnd     = Reg(Bool())
+  val rHasNextBlock = Reg(Bool())
   when(readEvent) {
-    when(rLeft =/= 0.U) {
-      rObj  := rObj + 1.U
-      rLeft := rLeft - 1.U
-    }.elsewhen(rBlockLeft >= m.U) {
+    when(!rBlockEnd) {
+      rObj      := rObj + 1.U
+      rLeft     := rLeft - 1.U
+      rBlockEnd := rLeft === 1.U
+    }.elsewhen(rHasNextBlock) {
       // Next block's stream: objects base+m+1 .. n-1.
-      rBase      := rBase + m.U
-      rObj       := rBase + (m + 1).U
-      rLeft      := rBlockLeft - m.U
-      rBlockLeft := rBlockLeft - m.U
+      rBase         := rBase + m.U
+      rObj          := rBase + (m + 1).U
+      rLeft         := rBlockLeft - m.U
+      rBlockLeft    := rBlockLeft - m.U
+      rBlockEnd     := rBlockLeft === m.U
+      rHasNextBlock := rBlockLeft >= (2 * m).U
     } // past the last block the stream is never compared: hold
   }
   val read = Wire(Valid(new Entry))
@@ -95,6 +107,14 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   readQueue.io.flush.get := io.launch.valid // drop what the last run read ahead
   assert(!issue || readQueue.io.deq.valid, "the stream's reader fell behind the schedule")
   assert(!readQueue.io.enq.valid || readQueue.io.enq.ready, "the stream's read queue overflowed")
+  // A run is launched only after its boxes were loaded, at least two cycles
+  // after the last run's last read left its pipeline, so the flush drops
+  // every read of that run and all credits come back.
+  assert(!io.launch.valid || readsInFlight === 0.U, "a read of the last run was in flight at a launch")
+  assert(
+    readQueue.io.count +& readsInFlight +& readCredits === readDepth.U || io.launch.valid,
+    "the stream's read credits do not match the queue"
+  )
 
   // ---- the window: lane k holds object s+k ----
   val window = Reg(Vec(m, new Entry))
@@ -182,6 +202,9 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     val longBlock = count >= (m + 2).U
     rObj  := Mux(longBlock, (m + 1).U, 0.U)
     rLeft := Mux(longBlock, count - (m + 2).U, 0.U)
+    rBlockEnd     := !longBlock || count === (m + 2).U
+    rHasNextBlock := count >= (m + 2).U // rBlockLeft = count-2 >= m
+    readCredits   := readDepth.U
   }
 
   // ---- comparators: registered compare, then registered AND ----
