@@ -33,7 +33,7 @@ BENCH_ARGS ?=
 FPGA_TEST_VERILOG := build/fpga-verilog/test-m2
 
 .PHONY: all deps test test-hw test-host test-fpga host bench verilog fpga fpga-sweep clean \
-        host-sanitize test-sanitize fuzz test-fuzz fuzz-long formal-long
+        host-sanitize test-sanitize print-other-arch fuzz test-fuzz fuzz-long formal-long
 
 all: test
 
@@ -99,6 +99,10 @@ host-sanitize: deps $(HOST_VERILOG)/filelist.f
 # sanitized libraries.
 test-sanitize: host-sanitize
 	$(SANITIZER_ENV) ctest --test-dir $(HOST_SANITIZE_BUILD) --output-on-failure -j 2 -E '^installed_package_example$$'
+
+# The architecture that is not the default (CI sanitizes the host built for it).
+print-other-arch:
+	@echo $(if $(filter seed,$(ARCH)),stream,seed)
 
 # libFuzzer targets on the box-file parser and the pair-finding API
 # (host/fuzz/README.md), built with clang, ASan and UBSan; no Verilator needed.
