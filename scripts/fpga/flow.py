@@ -727,18 +727,28 @@ def ecp5_breakdown(runner: Runner, yosys: str, src_list: str, mods: list[str], m
       its own: alone, ABC9's depth-driven mapping duplicates its log2(m) mux stages
       into per-output m:1 muxes (O(m^2): 108k LUT4 at m = 32), which the flat design
       does not do.
-    * ComparatorArray, ResultQueue, AddressSequencer: each synthesised on its own.
+    * Every other module (a "part": Loader, RunControl, AddressSequencer, the engine, the
+      result queue, ...): synthesised as top with the parts it instantiates (and the
+      Rotator) black-boxed, so each cell is counted in exactly one part; the engine's
+      row is its own glue (A registers, pipeline), not its sub-parts.
     * Top level + buffers: the rest (flat core minus all of the above); it
       also absorbs what flattening saves across module boundaries (registers that
       are equal in two modules are merged in the flat design), so it is a residual.
-    Memory-holding modules (CoordBuffer) stay flattened into the top, as in the real run."""
+    Memory-holding modules (CoordBuffer, the stream engine) stay flattened into the top,
+    as in the real run."""
     texts = {n: t for n, t in module_texts(runner.work, src_list.split()).items()}
     holds_mem = {n for n, t in texts.items() if any(re.search(rf"^\s*{mm}\s+\w+\s*\(", t, re.M) for mm in mem_modules)}
     subs = [n for n in mods if n not in (TOP, ROTATOR) and n not in mem_modules and n not in holds_mem]
     has_rot = ROTATOR in mods
     script = [f"read_verilog -sv {src_list}", "design -save sources"]
+    parts = set(subs) | ({ROTATOR} if has_rot else set())
+
+    def instantiates(parent: str, child: str) -> bool:
+        return re.search(rf"^\s*{child}\s+\w+\s*\(", texts.get(parent, ""), re.M) is not None
     for sub in subs:
-        script += [f"synth_ecp5 -top {sub}", f"tee -q -o breakdown_{sub}.json stat -json", "design -load sources"]
+        inner = sorted(c for c in parts if c != sub and instantiates(sub, c))
+        script += [f"hierarchy -top {sub}"] + ([f"blackbox {' '.join(inner)}"] if inner else []) + \
+                  [f"synth_ecp5 -top {sub}", f"tee -q -o breakdown_{sub}.json stat -json", "design -load sources"]
     script += [f"hierarchy -top {TOP}"] + ([f"blackbox {ROTATOR}"] if has_rot else []) + \
               [f"synth_ecp5 -top {TOP}", "tee -q -o breakdown_norot.json stat -json"]
     (runner.work / "breakdown.ys").write_text("\n".join(script) + "\n")
@@ -748,7 +758,8 @@ def ecp5_breakdown(runner: Runner, yosys: str, src_list: str, mods: list[str], m
         raise FlowError(EXIT_TOOL, "per-part synthesis failed")
 
     def row(cells: dict[str, int]) -> dict:
-        cells = {k: v for k, v in cells.items() if k not in (ROTATOR, "$scopeinfo")}
+        # Black-boxed sub-parts appear as cells named after their module: counted in their own row.
+        cells = {k: v for k, v in cells.items() if k not in parts and k != "$scopeinfo"}
         return {"lut4_slots": comb_cells(cells), "ffs": cells.get("TRELLIS_FF", 0),
                 "dp16kd": cells.get("DP16KD", 0), "ccu2c": cells.get("CCU2C", 0), "cells": cells}
 

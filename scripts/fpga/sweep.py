@@ -246,8 +246,8 @@ def render_breakdown(sweep: dict) -> list[str]:
     rows = ["Where the core's area goes (ECP5 synthesis, no wrapper; LUT4 slots = LUT4 + 2 x CCU2C; "
             "rotator = flat core minus the other parts, see the text):", "",
             "| m | rotator LUT4 | (2:1 muxes: 192·m·⌈log2 m⌉) | comparators LUT4 (6m × 32-bit) | result queue LUT4 | "
-            "sequencer LUT4 | top + buffers LUT4 | core LUT4 total | core FF | DP16KD |",
-            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+            "sequencer LUT4 | engine glue LUT4 / FF | top + buffers LUT4 | core LUT4 total | core FF | DP16KD |",
+            "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     n = 0
     for e in sweep["runs"]:
         d = e.get("data") or {}
@@ -264,8 +264,10 @@ def render_breakdown(sweep: dict) -> list[str]:
         top = next((v for k, v in mods.items() if k.startswith("top level")), {})
         core = b["flat_core_synth"]
         rows.append(f"| {d['m']} | {fmt(get('Rotator').get('lut4_slots'))} | {fmt(b['expected']['rotator_2to1_muxes'])} | "
-                    f"{fmt(get('ComparatorArray').get('lut4_slots'))} | {fmt(get('ResultQueue').get('lut4_slots'))} | "
-                    f"{fmt(get('AddressSequencer').get('lut4_slots'))} | {fmt(top.get('lut4_slots'))} | "
+                    f"{fmt(get('ComparatorArray').get('lut4_slots'))} | {fmt(get('Queue').get('lut4_slots'))} | "
+                    f"{fmt(get('AddressSequencer').get('lut4_slots'))} | "
+                    f"{fmt(get('SeedEngine').get('lut4_slots'))} / {fmt(get('SeedEngine').get('ffs'))} | "
+                    f"{fmt(top.get('lut4_slots'))} | "
                     f"{fmt(core['lut4_slots'])} | {fmt(core['ffs'])} | {core['dp16kd']} |")
         n += 1
     return rows + [""] if n else []
