@@ -43,10 +43,10 @@ def log(msg: str) -> None:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--arch", choices=["seed", "stream"], default="seed",
+    ap.add_argument("--arch", choices=["seed", "stream"], default="stream",
                     help="architecture; its reports are <prefix>m<M>.json (prefix '' for seed, 'stream-')")
     ap.add_argument("--capacity", type=int, default=None,
-                    help="objects per run (default: make's, 256*m for seed, 4096 for stream)")
+                    help="objects per run (default: make's, 256*m for seed, 2048 for stream)")
     ap.add_argument("--verilog-root", type=Path, default=REPO / "build" / "fpga-verilog",
                     help="directory with one m<M>/ Verilog dir per m")
     ap.add_argument("--results", type=Path, default=REPO / "results" / "fpga", help="where m<M>.json and sweep.json go")
