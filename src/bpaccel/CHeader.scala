@@ -14,8 +14,8 @@ object CHeader {
     */
   private def describe(p: AccelParams): String = {
     val fields = Seq(p.m, p.capacity, p.keyWidth, p.resultQueueDepth, p.memoryOutputStages, p.debugPort, p.arch) ++
-      (if (p.counterWidth != AccelParams().counterWidth) Seq(s"counterWidth = ${p.counterWidth}") else Nil) ++
-      Seq(s"batchCells = ${p.batchCells}") ++ (if (p.faults.nonEmpty) Seq(s"faults = ${p.faults}") else Nil)
+      (if (p.counterWidth != AccelParams().counterWidth) Seq(s"counterWidth=${p.counterWidth}") else Nil) ++
+      Seq(s"batchCells=${p.batchCells}") ++ (if (p.faults.nonEmpty) Seq(s"faults=${p.faults}") else Nil)
     fields.mkString("AccelParams(", ",", ")")
   }
 
