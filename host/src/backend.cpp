@@ -12,15 +12,53 @@ std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m) {
   return blocks * (n - 1) - m * blocks * (blocks - 1) / 2;
 }
 
+void Backend::runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
+                       std::vector<std::size_t>& cellEnds, RunStats& stats) {
+  for (const auto& cell : cells) {
+    run(cell, out, stats);
+    cellEnds.push_back(out.size());
+  }
+}
+
 ModelBackend::ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles,
-                           std::uint64_t streamReadLatency)
-    : m_(m), capacity_(capacity), overhead_(runOverheadCycles), streamReadLatency_(streamReadLatency) {
+                           std::uint64_t streamReadLatency, std::size_t batchCells)
+    : m_(m),
+      capacity_(capacity),
+      overhead_(runOverheadCycles),
+      streamReadLatency_(streamReadLatency),
+      batchCells_(batchCells) {
   // Only the seed architecture stripes objects over m memories.
   if (m == 0 || capacity < 2 || (streamReadLatency == 0 && capacity % m != 0))
     throw std::invalid_argument(fmt::format("model: invalid m = {} / capacity = {}", m, capacity));
+  if (batchCells == 0) throw std::invalid_argument("model: a batch must hold at least one cell");
 }
 
 void ModelBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) {
+  runCell(boxes, out, stats);
+  stats.runs += 1;
+  stats.batches += 1;
+}
+
+void ModelBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
+                            std::vector<std::size_t>& cellEnds, RunStats& stats) {
+  for (const auto& cell : cells)
+    if (cell.size() > capacity_)
+      throw std::length_error(fmt::format("model: a cell of {} boxes exceeds the capacity {}", cell.size(), capacity_));
+  for (std::size_t first = 0; first < cells.size(); first += batchCells_) {
+    const auto batch = cells.subspan(first, std::min(batchCells_, cells.size() - first));
+    for (const auto& cell : batch) {
+      runCell(cell, out, stats);
+      cellEnds.push_back(out.size());
+    }
+    // The front end: the cycle that takes the batch's first count, and per cell the cycle that ends it.
+    stats.loadCycles += 1;
+    stats.cycles += batch.size();
+    stats.runs += batch.size();
+    stats.batches += 1;
+  }
+}
+
+void ModelBackend::runCell(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) const {
   const std::size_t n = boxes.size();
   if (n > capacity_) throw std::length_error(fmt::format("model: {} boxes exceed the capacity {}", n, capacity_));
   const std::size_t before = out.size();
@@ -45,7 +83,6 @@ void ModelBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, Ru
   // load) while the first reads reach its entry.
   const std::uint64_t startup =
       n < 2 || streamReadLatency_ == 0 ? 0 : std::max<std::uint64_t>(m_ + 1 > n ? m_ + 1 - n : 0, streamReadLatency_);
-  stats.runs += 1;
   stats.loadCycles += n + 1;  // one box a cycle, then the start cycle
   stats.issueCycles += issue;
   stats.cycles += n < 2 ? 0 : startup + issue + overhead_;
@@ -58,6 +95,7 @@ void CpuBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunS
   const std::size_t before = out.size();
   kernel_.run(boxes, out, scratch_);
   stats.runs += 1;
+  stats.batches += 1;
   stats.hits += out.size() - before;
 }
 

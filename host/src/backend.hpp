@@ -21,8 +21,16 @@ class Backend {
   virtual std::string name() const = 0;
   /// Most boxes one run takes; larger sets are chunked by BroadPhase.
   virtual std::size_t capacity() const = 0;
-  /// Appends the overlapping pairs of `boxes` to `out` and adds to `stats`.
+  /// Appends the overlapping pairs of `boxes` to `out` and adds to `stats`
+  /// (one run, one batch).
   virtual void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) = 0;
+  /// Runs several cells, each at most capacity() boxes: appends each cell's
+  /// pairs (indices local to that cell, i < j) to `out` in cell order and
+  /// pushes out.size() onto `cellEnds` after each cell. `stats.runs` counts
+  /// the cells; `stats.batches` the hand-overs to the device. By default each
+  /// cell is its own run (and so its own batch).
+  virtual void runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
+                        std::vector<std::size_t>& cellEnds, RunStats& stats);
 };
 
 /// The accelerator's schedule in closed form: issue cycles of one run of n
@@ -38,19 +46,27 @@ std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m);
 /// in the cycles before the first issue: none for the seed's; for the
 /// stream's, max(m + 1 - n, streamReadLatency) (BPACCEL_READ_LATENCY, 0 for
 /// the seed's, so passing the header's values always models the hardware built).
+/// Batches of up to `batchCells` cells (BPACCEL_BATCH_CELLS) cost what the
+/// hardware's front end adds: one cycle per batch and one per cell.
 class ModelBackend final : public Backend {
  public:
   ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles,
-               std::uint64_t streamReadLatency = 0);
+               std::uint64_t streamReadLatency = 0, std::size_t batchCells = 64);
   std::string name() const override { return "model"; }
   std::size_t capacity() const override { return capacity_; }
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
+  void runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
+                std::vector<std::size_t>& cellEnds, RunStats& stats) override;
 
  private:
+  /// One cell's pairs and counters, without counting it as a run.
+  void runCell(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) const;
+
   std::size_t m_;
   std::size_t capacity_;
   std::uint64_t overhead_;
   std::uint64_t streamReadLatency_;  // 0: the seed architecture
+  std::size_t batchCells_;
 };
 
 /// Software alone: all pairs of the batch with SIMD compares (AllPairsKernel),

@@ -30,6 +30,24 @@ void setBox(VBroadPhaseAccel& top, const KeyBox& b) {
   top.io_load_bits_max_2 = b.max[2];
 }
 
+// Appends the pairs of the beat on the result port to `out`.
+void appendBeat(const VBroadPhaseAccel& top, std::vector<Pair>& out) {
+  const std::uint32_t i0 = top.io_result_bits_iBase;
+  const std::uint32_t j0 = top.io_result_bits_jBase;
+  for (std::size_t k = 0; k < BPACCEL_M; ++k)
+    if (maskBit(top.io_result_bits_mask, k))
+      out.emplace_back(i0 + static_cast<std::uint32_t>(k), j0 + static_cast<std::uint32_t>(k));
+}
+
+// Adds the hardware's counters of its last run or batch to `stats`.
+void addCounters(const VBroadPhaseAccel& top, RunStats& stats) {
+  stats.loadCycles += top.io_counters_loadCycles;
+  stats.cycles += top.io_counters_cycles;
+  stats.issueCycles += top.io_counters_issueCycles;
+  stats.stallCycles += top.io_counters_stallCycles;
+  stats.hits += top.io_counters_hits;
+}
+
 }  // namespace
 
 static_assert(BPACCEL_KEY_WIDTH == 32, "the host maps float32 to 32-bit keys");
@@ -52,17 +70,21 @@ RtlBackend::RtlBackend(std::function<bool(std::uint64_t)> consumerReady)
   check("key width", top_->io_info_keyWidth, BPACCEL_KEY_WIDTH);
   check("run overhead cycles", top_->io_info_runOverheadCycles, BPACCEL_RUN_OVERHEAD_CYCLES);
   check("read latency", top_->io_info_readLatency, BPACCEL_READ_LATENCY);
+  check("batch cells", top_->io_info_batchCells, BPACCEL_BATCH_CELLS);
+  check("cell tag width", top_->io_info_cellTagWidth, BPACCEL_CELL_TAG_WIDTH);
 }
 
 RtlBackend::~RtlBackend() { top_->final(); }
 
 std::size_t RtlBackend::capacity() const { return BPACCEL_CAPACITY; }
 std::size_t RtlBackend::lanes() { return BPACCEL_M; }
+std::size_t RtlBackend::batchCells() { return BPACCEL_BATCH_CELLS; }
 std::uint64_t RtlBackend::runOverheadCycles() { return BPACCEL_RUN_OVERHEAD_CYCLES; }
 std::string RtlBackend::architecture() { return BPACCEL_ARCH; }
 
 ModelBackend modelOfBuiltHardware() {
-  return ModelBackend(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES, BPACCEL_READ_LATENCY);
+  return ModelBackend(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES, BPACCEL_READ_LATENCY,
+                      BPACCEL_BATCH_CELLS);
 }
 
 void RtlBackend::settle() {
@@ -80,6 +102,7 @@ void RtlBackend::tick() {
 void RtlBackend::reset() {
   top_->io_load_valid = 0;
   top_->io_start_valid = 0;
+  top_->io_cells_valid = 0;
   top_->io_result_ready = 0;
   top_->reset = 1;
   tick();
@@ -137,11 +160,7 @@ void RtlBackend::runOnHardware(std::span<const KeyBox> boxes, std::vector<Pair>&
     settle();
     if (!top.io_status_busy) break;
     if (ready && top.io_result_valid) {
-      const std::uint32_t i0 = top.io_result_bits_iBase;
-      const std::uint32_t j0 = top.io_result_bits_jBase;
-      for (std::size_t k = 0; k < BPACCEL_M; ++k)
-        if (maskBit(top.io_result_bits_mask, k))
-          out.emplace_back(i0 + static_cast<std::uint32_t>(k), j0 + static_cast<std::uint32_t>(k));
+      appendBeat(top, out);
       ++beats;
     }
     tick();
@@ -155,12 +174,101 @@ void RtlBackend::runOnHardware(std::span<const KeyBox> boxes, std::vector<Pair>&
     throw std::runtime_error(fmt::format("rtl: hardware counted {} hits but {} pairs arrived",
                                          top.io_counters_hits, out.size() - before));
   stats.runs += 1;
-  stats.loadCycles += top.io_counters_loadCycles;
-  stats.cycles += top.io_counters_cycles;
-  stats.issueCycles += top.io_counters_issueCycles;
-  stats.stallCycles += top.io_counters_stallCycles;
-  stats.hits += top.io_counters_hits;
+  stats.batches += 1;
+  addCounters(top, stats);
   stats.boxesSent += n;
+  stats.beatsReceived += beats;
+}
+
+void RtlBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
+                          std::vector<std::size_t>& cellEnds, RunStats& stats) {
+  for (std::size_t k = 0; k < cells.size(); ++k)
+    if (cells[k].size() > capacity())
+      throw std::length_error(
+          fmt::format("rtl: cell {} has {} boxes, above the hardware capacity {}", k, cells[k].size(), capacity()));
+  const std::size_t pairsBefore = out.size();
+  const std::size_t endsBefore = cellEnds.size();
+  RunStats added;
+  try {
+    for (std::size_t first = 0; first < cells.size(); first += BPACCEL_BATCH_CELLS)
+      batchOnHardware(cells.subspan(first, std::min<std::size_t>(BPACCEL_BATCH_CELLS, cells.size() - first)), out,
+                      cellEnds, added);
+  } catch (...) {
+    reset();
+    out.resize(pairsBefore);
+    cellEnds.resize(endsBefore);
+    throw;
+  }
+  stats += added;
+}
+
+void RtlBackend::batchOnHardware(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
+                                 std::vector<std::size_t>& cellEnds, RunStats& stats) {
+  VBroadPhaseAccel& top = *top_;
+  const std::size_t batchPairsBefore = out.size();
+  std::uint64_t issue = 0, boxes = 0;
+  for (const auto& cell : cells) {
+    issue += scheduleIssueCycles(cell.size(), BPACCEL_M);
+    boxes += cell.size();
+  }
+  // A bound far above any legal batch turns a hang into an error.
+  const std::uint64_t limit = 64 * (issue + boxes + 1000 * (cells.size() + 1));
+  std::size_t nextCount = 0, cell = 0, box = 0;  // next count to push; cell and box being streamed
+  std::size_t resultCell = 0;                     // the cell whose beats arrive now
+  bool began = false;
+  std::uint64_t beats = 0;
+  for (std::uint64_t cycle = 0;; ++cycle) {
+    if (cycle > limit) throw std::runtime_error(fmt::format("rtl: batch of {} cells did not finish", cells.size()));
+    while (cell < cells.size() && box == cells[cell].size()) {
+      ++cell;
+      box = 0;
+    }
+    const bool countOffered = nextCount < cells.size();
+    top.io_cells_valid = countOffered;
+    if (countOffered) top.io_cells_bits = static_cast<std::uint32_t>(cells[nextCount].size());
+    const bool boxOffered = cell < cells.size();
+    top.io_load_valid = boxOffered;
+    if (boxOffered) setBox(top, cells[cell][box]);
+    const bool ready = consumerReady_(cycle);
+    top.io_result_ready = ready;
+    settle();
+    if (began && !countOffered && !boxOffered && !top.io_status_busy) break;
+    if (countOffered && top.io_cells_ready) {
+      began = true;
+      ++nextCount;
+    } else if (!began) {
+      throw std::runtime_error("rtl: batch port not ready while idle");
+    }
+    if (boxOffered && top.io_load_ready) ++box;
+    if (ready && top.io_result_valid) {
+      // Beats arrive in cell order; a hardware batch never holds more cells than tags.
+      const std::size_t tag = top.io_result_bits_cell;
+      if (tag < resultCell || tag >= cells.size())
+        throw std::runtime_error(fmt::format("rtl: beat of cell {} after cell {} of {}", tag, resultCell, cells.size()));
+      for (; resultCell < tag; ++resultCell) cellEnds.push_back(out.size());
+      appendBeat(top, out);
+      ++beats;
+    }
+    tick();
+  }
+  for (; resultCell < cells.size(); ++resultCell) cellEnds.push_back(out.size());
+  top.io_cells_valid = 0;
+  top.io_load_valid = 0;
+  top.io_result_ready = 0;
+  settle();
+  if (!top.io_status_done) throw std::runtime_error("rtl: the batch ended without done");
+  if (top.io_status_error != BPACCEL_ERROR_NONE)
+    throw std::runtime_error(fmt::format("rtl: hardware reported error code {} in a batch", top.io_status_error));
+  if (top.io_status_cellsDone != cells.size())
+    throw std::runtime_error(
+        fmt::format("rtl: hardware ended {} cells of a batch of {}", top.io_status_cellsDone, cells.size()));
+  if (top.io_counters_hits != out.size() - batchPairsBefore)
+    throw std::runtime_error(fmt::format("rtl: hardware counted {} hits but {} pairs arrived in a batch",
+                                         top.io_counters_hits, out.size() - batchPairsBefore));
+  stats.runs += cells.size();
+  stats.batches += 1;
+  addCounters(top, stats);
+  stats.boxesSent += boxes;
   stats.beatsReceived += beats;
 }
 

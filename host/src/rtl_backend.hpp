@@ -30,8 +30,15 @@ class RtlBackend final : public Backend {
   /// On any failure (a hang, a hardware error) the device is reset before the
   /// exception leaves, so the next run starts from an idle accelerator.
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
+  /// Pushes the cells' counts on the batch port and streams their boxes, one
+  /// a cycle, as hardware batches of at most batchCells() cells each. On any
+  /// failure the device is reset and nothing of the call is left in `out`,
+  /// `cellEnds` or `stats`.
+  void runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
+                std::vector<std::size_t>& cellEnds, RunStats& stats) override;
 
   static std::size_t lanes();
+  static std::size_t batchCells();
   /// "seed" or "stream": the architecture this host was built with.
   static std::string architecture();
   static std::uint64_t runOverheadCycles();
@@ -41,6 +48,8 @@ class RtlBackend final : public Backend {
   void tick();    // one rising clock edge
   void reset();
   void runOnHardware(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats);
+  void batchOnHardware(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
+                       std::vector<std::size_t>& cellEnds, RunStats& stats);
 
   std::unique_ptr<VerilatedContext> context_;
   std::unique_ptr<VBroadPhaseAccel> top_;

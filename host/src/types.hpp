@@ -32,6 +32,7 @@ using Pair = std::pair<std::uint32_t, std::uint32_t>;
 /// What the backends spent on one frame (or one call), summed over all runs.
 struct RunStats {
   std::uint64_t runs = 0;          // accelerator runs (one per cell or chunk pair)
+  std::uint64_t batches = 0;       // hand-overs to the device: one per run, one per hardware batch of cells
   std::uint64_t loadCycles = 0;    // hardware cycles spent loading boxes before each start, summed
   std::uint64_t cycles = 0;        // hardware cycles, start to done, summed
   std::uint64_t issueCycles = 0;   // cycles the comparator array had work
@@ -45,6 +46,7 @@ struct RunStats {
 
   RunStats& operator+=(const RunStats& o) {
     runs += o.runs;
+    batches += o.batches;
     loadCycles += o.loadCycles;
     cycles += o.cycles;
     issueCycles += o.issueCycles;

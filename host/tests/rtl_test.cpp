@@ -2,6 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <span>
+#include <tuple>
+
+#include <fmt/format.h>
 
 #include "backend.hpp"
 #include "bpaccel_params.h"
@@ -164,4 +168,158 @@ TEST(RtlBackend, RejectsABatchAboveTheCapacity) {
   std::vector<Pair> pairs;
   RunStats stats;
   EXPECT_THROW(rtl.run(keys, pairs, stats), std::length_error);
+}
+
+namespace {
+
+// A batch of cells in float boxes and keys, and the spans a Backend takes.
+struct Batch {
+  std::vector<std::vector<Aabb>> boxes;
+  std::vector<std::vector<KeyBox>> keys;
+  std::vector<std::span<const KeyBox>> spans;
+};
+
+// Cells whose sizes hit the edges (0, 1, 2, m, m+1, the capacity) or are
+// random, each one of the adversarial scenes (touching, identical, ...).
+Batch randomBatch(std::size_t cells, unsigned seed, bool withFullCell) {
+  std::mt19937 rng(seed);
+  const std::vector<std::size_t> edges = {0, 1, 2, BPACCEL_M, BPACCEL_M + 1};
+  Batch b;
+  for (std::size_t k = 0; k < cells; ++k) {
+    std::size_t n = rng() % 3 == 0 ? rng() % 120 : edges[rng() % edges.size()];
+    if (withFullCell && k == cells / 2) n = BPACCEL_CAPACITY;
+    auto scenes = adversarialScenes(n, static_cast<unsigned>(rng()));
+    b.boxes.push_back(std::move(scenes.at(rng() % scenes.size()).second));
+  }
+  for (const auto& c : b.boxes) b.keys.push_back(keysOf(c));
+  for (const auto& c : b.keys) b.spans.emplace_back(c);
+  return b;
+}
+
+struct BatchResult {
+  std::vector<Pair> pairs;
+  std::vector<std::size_t> cellEnds;
+  RunStats stats;
+};
+
+BatchResult runBatchOn(Backend& backend, const Batch& b) {
+  BatchResult r;
+  backend.runBatch(b.spans, r.pairs, r.cellEnds, r.stats);
+  return r;
+}
+
+// The pairs of cell k of a batch result.
+std::vector<Pair> cellPairs(const BatchResult& r, std::size_t k) {
+  const std::size_t begin = k == 0 ? 0 : r.cellEnds.at(k - 1);
+  return {r.pairs.begin() + static_cast<std::ptrdiff_t>(begin), r.pairs.begin() + static_cast<std::ptrdiff_t>(r.cellEnds.at(k))};
+}
+
+std::uint64_t hardwareBatches(std::size_t cells) { return (cells + BPACCEL_BATCH_CELLS - 1) / BPACCEL_BATCH_CELLS; }
+
+}  // namespace
+
+TEST(RtlBatch, AgreesWithTheModelAndWithTheCellsRunOneByOne) {
+  RtlBackend rtl;
+  ModelBackend model = modelOfBuiltHardware();
+  // Few cells, one at the capacity, and more cells than one hardware batch holds.
+  for (const auto& [cells, seed, full] : {std::tuple{5u, 1u, false}, std::tuple{9u, 2u, true},
+                                          std::tuple{BPACCEL_BATCH_CELLS + 7u, 3u, false}}) {
+    const Batch b = randomBatch(cells, seed, full);
+    const std::string label = fmt::format("{} cells, seed {}", cells, seed);
+    const BatchResult fromRtl = runBatchOn(rtl, b);
+    const BatchResult fromModel = runBatchOn(model, b);
+    EXPECT_EQ(fromRtl.pairs, fromModel.pairs) << label;
+    EXPECT_EQ(fromRtl.cellEnds, fromModel.cellEnds) << label;
+    ASSERT_EQ(fromRtl.cellEnds.size(), cells) << label;
+    const RunStats& r = fromRtl.stats;
+    const RunStats& m = fromModel.stats;
+    EXPECT_EQ(r.runs, cells) << label;
+    EXPECT_EQ(r.batches, hardwareBatches(cells)) << label;
+    EXPECT_EQ(m.batches, r.batches) << label;
+    EXPECT_EQ(r.loadCycles, m.loadCycles) << label;
+    EXPECT_EQ(r.cycles, m.cycles) << label;
+    EXPECT_EQ(r.issueCycles, m.issueCycles) << label;
+    EXPECT_EQ(r.beatsReceived, m.beatsReceived) << label;
+    EXPECT_EQ(r.hits, fromRtl.pairs.size()) << label;
+    EXPECT_EQ(r.stallCycles, 0u) << label;
+    // Cell by cell: the same pairs, in the same order, as single runs; the
+    // batch costs their cycles plus one per cell and one per hardware batch.
+    RunStats singles;
+    for (std::size_t k = 0; k < cells; ++k) {
+      std::vector<Pair> one;
+      rtl.run(b.spans[k], one, singles);
+      EXPECT_EQ(cellPairs(fromRtl, k), one) << label << " cell " << k;
+      EXPECT_EQ(sorted(one), bruteForce(b.boxes[k])) << label << " cell " << k;
+    }
+    EXPECT_EQ(r.loadCycles, singles.loadCycles + r.batches) << label;
+    EXPECT_EQ(r.cycles, singles.cycles + cells) << label;
+    EXPECT_EQ(r.hits, singles.hits) << label;
+    EXPECT_EQ(singles.batches, cells) << label;
+    if (cells > BPACCEL_BATCH_CELLS) {
+      // The counter comparison can fail: a model that splits into other hardware batches disagrees.
+      ModelBackend wrongSplit(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES, BPACCEL_READ_LATENCY,
+                              BPACCEL_BATCH_CELLS > 1 ? 1 : 2);
+      EXPECT_NE(runBatchOn(wrongSplit, b).stats.loadCycles, r.loadCycles) << label;
+    }
+  }
+}
+
+TEST(RtlBatch, StallingConsumerLosesNoPairAndCountsTheStalls) {
+  std::mt19937 pattern(6);
+  RtlBackend rtl([&](std::uint64_t) { return pattern() % 3 == 0; });
+  ModelBackend model = modelOfBuiltHardware();
+  const Batch b = randomBatch(BPACCEL_BATCH_CELLS + 2, 4, false);
+  const BatchResult fromRtl = runBatchOn(rtl, b);
+  const BatchResult fromModel = runBatchOn(model, b);
+  EXPECT_EQ(fromRtl.pairs, fromModel.pairs);
+  EXPECT_EQ(fromRtl.cellEnds, fromModel.cellEnds);
+  EXPECT_GT(fromRtl.stats.stallCycles, 0u);
+  EXPECT_EQ(fromRtl.stats.cycles, fromModel.stats.cycles + fromRtl.stats.stallCycles);
+  EXPECT_EQ(fromRtl.stats.loadCycles, fromModel.stats.loadCycles);
+}
+
+TEST(RtlBatch, TheDefaultRunsEachCellAsItsOwnBatch) {
+  CpuBackend cpu;
+  ModelBackend model = modelOfBuiltHardware();
+  const Batch b = randomBatch(12, 5, false);
+  const BatchResult fromCpu = runBatchOn(cpu, b);
+  const BatchResult fromModel = runBatchOn(model, b);
+  ASSERT_EQ(fromCpu.cellEnds.size(), 12u);
+  for (std::size_t k = 0; k < 12; ++k)
+    EXPECT_EQ(sorted(cellPairs(fromCpu, k)), sorted(cellPairs(fromModel, k))) << "cell " << k;
+  EXPECT_EQ(fromCpu.stats.runs, 12u);
+  EXPECT_EQ(fromCpu.stats.batches, 12u);
+}
+
+TEST(RtlBatch, RejectsACellAboveTheCapacityBeforeTouchingTheDevice) {
+  RtlBackend rtl;
+  std::vector<KeyBox> small(3, KeyBox{{0, 0, 0}, {1, 1, 1}});
+  std::vector<KeyBox> big(BPACCEL_CAPACITY + 1, KeyBox{{0, 0, 0}, {1, 1, 1}});
+  const std::vector<std::span<const KeyBox>> cells = {small, big};
+  std::vector<Pair> pairs;
+  std::vector<std::size_t> ends;
+  RunStats stats;
+  EXPECT_THROW(rtl.runBatch(cells, pairs, ends, stats), std::length_error);
+  EXPECT_TRUE(pairs.empty());
+  EXPECT_TRUE(ends.empty());
+  EXPECT_EQ(stats.runs, 0u);
+}
+
+TEST(RtlBatch, RecoversAfterAHungBatchAndRunsTheNextExactly) {
+  bool consumerStuck = true;  // a consumer that never takes a beat hangs the batch
+  RtlBackend rtl([&](std::uint64_t) { return !consumerStuck; });
+  ModelBackend model = modelOfBuiltHardware();
+  const Batch b = randomBatch(4, 7, false);
+  ASSERT_FALSE(runBatchOn(model, b).pairs.empty());  // a beat the consumer never takes
+  std::vector<Pair> pairs = {{0, 1}};  // what the caller had before stays
+  std::vector<std::size_t> ends = {1};
+  RunStats stats;
+  EXPECT_THROW(rtl.runBatch(b.spans, pairs, ends, stats), std::runtime_error);
+  EXPECT_EQ(pairs.size(), 1u);
+  EXPECT_EQ(ends.size(), 1u);
+  EXPECT_EQ(stats.runs, 0u);
+  EXPECT_EQ(stats.batches, 0u);
+  consumerStuck = false;
+  const BatchResult fromRtl = runBatchOn(rtl, b);
+  EXPECT_EQ(fromRtl.pairs, runBatchOn(model, b).pairs);
 }

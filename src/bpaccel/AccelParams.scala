@@ -38,6 +38,7 @@ object Arch {
   * @param counterWidth     bits of each run counter (cycles, hits, ...); 64 cannot overflow
   *                         within any run this design can hold. The formal checks narrow
   *                         them: their runs are short and wide adders slow the solver.
+  * @param batchCells       cell counts the batch front end queues (see [[BatchControl]])
   * @param faults           deliberate bugs for the formal checks' mutant tests (see [[Fault]]);
   *                         empty for every real build
   */
@@ -50,6 +51,7 @@ case class AccelParams(
   debugPort: Boolean = false,
   arch: Arch = Arch.Seed,
   counterWidth: Int = 64,
+  batchCells: Int = 64,
   faults: Set[Fault] = Set.empty
 ) {
   require(m >= 1, s"parallelism m must be at least 1, got m = $m")
@@ -64,7 +66,11 @@ case class AccelParams(
   )
   require(keyWidth >= 1 && keyWidth <= 64, s"keyWidth must lie in 1..64, got keyWidth = $keyWidth")
   require(counterWidth >= 1 && counterWidth <= 64, s"counterWidth must lie in 1..64, got counterWidth = $counterWidth")
+  require(batchCells >= 1 && batchCells < (1 << 16), s"batchCells must lie in 1..65535, got batchCells = $batchCells")
   require(m < (1 << 16) && capacity.toLong < (1L << 32), s"m must fit 16 bits and capacity 32 bits, got m = $m, capacity = $capacity")
+
+  /** Bits of a result beat's cell tag: the index of its cell within its batch. */
+  val cellTagWidth: Int = log2Ceil(batchCells).max(1)
 
   /** Rows of each of the m striped memories of the seed architecture. */
   val depth: Int = (capacity / m).max(1)

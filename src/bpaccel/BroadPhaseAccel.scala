@@ -14,6 +14,11 @@ import chisel3.util._
   * the capacity or than the boxes loaded ends the run at once with an error
   * and no results, never with a partial answer.
   *
+  * Batches: push the box counts of up to `batchCells` cells on `cells`, then
+  * stream all their boxes on `load`; [[BatchControl]] runs the cells one
+  * after the other and result beats carry their cell's index. A start is
+  * refused while a batch is under way.
+  *
   * Back-pressure by credits: the engine only issues a schedule cycle when the
   * result queue is sure to have room for it once it leaves the pipeline, so
   * the pipeline after the issue never stalls and no hit is ever dropped or
@@ -23,6 +28,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   val io = IO(new Bundle {
     val load     = Flipped(Decoupled(new Aabb(p.keyWidth)))
     val start    = Flipped(Decoupled(UInt(p.countWidth.W)))
+    val cells    = Flipped(Decoupled(UInt(p.countWidth.W)))
     val result   = Decoupled(new ResultBeat(p))
     val status   = Output(new AccelStatus(p))
     val counters = Output(new AccelCounters(p))
@@ -32,6 +38,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
 
   val loader  = Module(new Loader(p))
   val control = Module(new RunControl(p))
+  val batch   = Module(new BatchControl(p))
   val engine = p.arch match {
     case Arch.Seed   => Module(new SeedEngine(p))
     case Arch.Stream => Module(new StreamEngine(p))
@@ -39,19 +46,40 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   // A beat that meets an empty queue and a ready consumer passes in the same cycle.
   val queue = Module(new Queue(new ResultBeat(p), p.resultQueueDepth, flow = true))
 
-  // A start in the same cycle wins, so a box is never loaded into the next run by accident.
-  io.load.ready       := !control.io.status.busy && !io.start.valid
+  batch.io.cells <> io.cells
+  batch.io.hostStart := io.start.valid
+  batch.io.runBusy   := control.io.status.busy
+  batch.io.loadFire  := io.load.fire
+
+  // The run control's start: the host's outside a batch, the front end's within one.
+  val start = Wire(Decoupled(UInt(p.countWidth.W)))
+  start.valid    := Mux(batch.io.active, batch.io.start.valid, io.start.valid)
+  start.bits     := Mux(batch.io.active, batch.io.start.bits, io.start.bits)
+  io.start.ready := start.ready && !batch.io.active
+  assert(!batch.io.start.valid || start.ready, "the batch front end started a cell while a run was busy")
+  // Starts clear the loader, and so does a batch's first count: its first box is object 0.
+  val clear = start.fire || batch.io.begin
+
+  // A start or a batch's first count in the same cycle wins, so a box is never loaded into the next run by accident.
+  io.load.ready := Mux(
+    batch.io.active,
+    batch.io.loadReady,
+    !control.io.status.busy && !io.start.valid && !io.cells.valid
+  )
   loader.io.load.valid := io.load.fire
   loader.io.load.bits  := io.load.bits
-  loader.io.clear      := io.start.fire
+  loader.io.clear      := clear
 
-  control.io.start <> io.start
+  control.io.start <> start
+  control.io.accumulate    := batch.io.accumulate
+  control.io.batchBegin    := batch.io.begin
+  control.io.frontEndCycle := batch.io.cellEnd
   control.io.loadFire := io.load.fire
   control.io.loaded   := loader.io.loaded
   control.io.overflow := loader.io.overflow
 
   engine.io.write   := loader.io.write
-  engine.io.clear   := io.start.fire
+  engine.io.clear   := clear
   engine.io.launch  := control.io.launch
   // Credits, registered so that no adder sits before the engine's enables:
   // queue count + cycles in flight grows by at most one a cycle, so room for
@@ -64,7 +92,10 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
 
   val beat = engine.io.out
   queue.io.enq.valid := beat.valid && beat.bits.mask.orR
-  queue.io.enq.bits  := beat.bits
+  queue.io.enq.bits.iBase := beat.bits.iBase
+  queue.io.enq.bits.jBase := beat.bits.jBase
+  queue.io.enq.bits.mask  := beat.bits.mask
+  queue.io.enq.bits.cell  := batch.io.cell
   assert(!queue.io.enq.valid || queue.io.enq.ready, "result queue overflow: credit accounting is broken")
   io.result <> queue.io.deq
   if (p.has(Fault.DropBeatWhenNotReady)) queue.io.deq.ready := true.B
@@ -75,7 +106,12 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   control.io.queuedHits := Pipe(queue.io.enq.fire, PopCount(beat.bits.mask))
   control.io.queueEmpty       := queue.io.count === 0.U
 
-  io.status   := control.io.status
+  io.status.error     := control.io.status.error
+  io.status.loaded    := control.io.status.loaded
+  io.status.busy      := control.io.status.busy || batch.io.active
+  io.status.done      := control.io.status.done && !batch.io.active
+  io.status.batch     := batch.io.active
+  io.status.cellsDone := batch.io.cellsDone
   io.counters := control.io.counters
 
   io.info.arch              := p.arch.id.U
@@ -84,6 +120,8 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   io.info.keyWidth          := p.keyWidth.U
   io.info.runOverheadCycles := p.runOverheadCycles.U
   io.info.readLatency       := (if (p.arch == Arch.Stream) p.readLatency else 0).U
+  io.info.batchCells        := p.batchCells.U
+  io.info.cellTagWidth      := p.cellTagWidth.U
 
   io.debug.foreach(_ := engine.io.probe.get)
 

@@ -9,14 +9,22 @@ class Aabb(keyWidth: Int) extends Bundle {
   val max = Vec(3, UInt(keyWidth.W))
 }
 
-/** One result beat: all hits of one schedule cycle.
+/** What an engine produces each issued schedule cycle: all its hits.
   * Lane k set in `mask` means objects (iBase + k) and (jBase + k) overlap,
   * with iBase + k < jBase + k always.
   */
-class ResultBeat(p: AccelParams) extends Bundle {
+class ScheduleBeat(p: AccelParams) extends Bundle {
   val iBase = UInt(p.indexWidth.W)
   val jBase = UInt(p.indexWidth.W)
   val mask  = UInt(p.m.W)
+}
+
+/** One result beat: a schedule cycle with at least one hit, and the cell of
+  * its batch it belongs to (index within the batch from 0, modulo
+  * 2^cellTagWidth; 0 for a single run). Indices are local to that cell.
+  */
+class ResultBeat(p: AccelParams) extends ScheduleBeat(p) {
+  val cell = UInt(p.cellTagWidth.W)
 }
 
 /** Error codes of a run, also written into the C header. */
@@ -34,13 +42,20 @@ object AccelError extends ChiselEnum {
   def code(e: Type): Int = e.litValue.toInt
 }
 
-class AccelStatus(p: AccelParams) extends Bundle {
-  val busy   = Bool()
-  val done   = Bool() // the last run ended (with or without error) and nothing started since
-  val error  = AccelError()
+/** What run control knows: its run, or the batch it runs. */
+class RunStatus(p: AccelParams) extends Bundle {
+  val busy   = Bool() // a run or a batch is under way
+  val done   = Bool() // the last run or batch ended (with or without error) and nothing started since
+  val error  = AccelError() // in a batch: the first error of any of its cells
   val loaded = UInt(p.countWidth.W)
 }
 
+class AccelStatus(p: AccelParams) extends RunStatus(p) {
+  val batch     = Bool()     // a batch is under way: cells are queued or running
+  val cellsDone = UInt(32.W) // cells of the current or last batch that have ended
+}
+
+/** Of the last run, or summed over the cells of the last batch (see docs/microarchitecture.md). */
 class AccelCounters(p: AccelParams) extends Bundle {
   val loadCycles  = UInt(p.counterWidth.W) // first box loaded .. start accepted, both included (1 if no box)
   val cycles      = UInt(p.counterWidth.W) // start accepted .. done
@@ -72,6 +87,8 @@ class AccelInfo extends Bundle {
   val keyWidth          = UInt(8.W)
   val runOverheadCycles = UInt(8.W)
   val readLatency       = UInt(8.W) // stream: startup is max(m + 1 - n, readLatency) cycles
+  val batchCells        = UInt(16.W) // cell counts the batch queue holds
+  val cellTagWidth      = UInt(8.W)  // bits of a result beat's cell tag
 }
 
 /** The ports every architecture's engine offers the shared top level. */
@@ -81,7 +98,7 @@ class EngineIO(p: AccelParams) extends Bundle {
   val launch   = Flipped(Valid(UInt(p.countWidth.W))) // a run of n >= 2 objects, all loaded
   val advance  = Input(Bool())                        // the result queue has room for one more issue
   val activity = Output(new EngineActivity(p))
-  val out      = Valid(new ResultBeat(p))             // one per issued cycle, mask = hits
+  val out      = Valid(new ScheduleBeat(p))           // one per issued cycle, mask = hits
   val probe    = if (p.debugPort) Some(Output(new DebugProbe(p))) else None
 }
 

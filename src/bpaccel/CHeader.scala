@@ -7,14 +7,15 @@ object CHeader {
   /** One string that names the whole configuration; the host compares it. */
   def fingerprint(p: AccelParams): String =
     s"arch=${p.arch.name},m=${p.m},capacity=${p.capacity},key_width=${p.keyWidth},queue=${p.resultQueueDepth}," +
-      s"memstages=${p.memoryOutputStages},debug=${if (p.debugPort) 1 else 0}"
+      s"memstages=${p.memoryOutputStages},debug=${if (p.debugPort) 1 else 0},batch=${p.batchCells}"
 
   /** The parameters in AccelParams' own notation, leaving out the fields only
     * the formal checks change while they hold their defaults.
     */
   private def describe(p: AccelParams): String = {
     val fields = Seq(p.m, p.capacity, p.keyWidth, p.resultQueueDepth, p.memoryOutputStages, p.debugPort, p.arch) ++
-      (if (p.counterWidth != AccelParams().counterWidth || p.faults.nonEmpty) Seq(p.counterWidth, p.faults) else Nil)
+      (if (p.counterWidth != AccelParams().counterWidth) Seq(s"counterWidth=${p.counterWidth}") else Nil) ++
+      Seq(s"batchCells=${p.batchCells}") ++ (if (p.faults.nonEmpty) Seq(s"faults=${p.faults}") else Nil)
     fields.mkString("AccelParams(", ",", ")")
   }
 
@@ -33,6 +34,8 @@ object CHeader {
       "RUN_OVERHEAD_CYCLES" -> p.runOverheadCycles.toString,
       "READ_LATENCY"        -> (if (p.arch == Arch.Stream) p.readLatency else 0).toString,
       "DEBUG_PORT"          -> (if (p.debugPort) "1" else "0"),
+      "BATCH_CELLS"         -> p.batchCells.toString,
+      "CELL_TAG_WIDTH"      -> p.cellTagWidth.toString,
       "FINGERPRINT"         -> s"\"${fingerprint(p)}\""
     ) ++ AccelError.names.map { case (name, e) => s"ERROR_$name" -> AccelError.code(e).toString }
     val body = defines.map { case (k, v) => s"#define BPACCEL_$k $v" }.mkString("\n")
@@ -43,7 +46,7 @@ object CHeader {
        |$body
        |
        |/* Result encoding: one beat per schedule cycle with at least one hit,
-       | * fields {iBase, jBase, mask[M]}. Bit k of mask set means objects
+       | * fields {iBase, jBase, mask[M], cell}. Bit k of mask set means objects
        | * iBase + k and jBase + k overlap, and iBase + k < jBase + k.
        | * A run of n >= 2 objects with a consumer that never stalls takes
        | * startup(n) + issue_cycles(n) + BPACCEL_RUN_OVERHEAD_CYCLES cycles, where
@@ -55,7 +58,15 @@ object CHeader {
        | * to the cycle that accepts its start, both included (n + 1 when the
        | * host loads one box a cycle and starts at once; 1 with no box);
        | * cycles counts from the cycle after the start to done. A run keeps the
-       | * device busy for load_cycles + cycles. */
+       | * device busy for load_cycles + cycles.
+       | * Batches: push up to BPACCEL_BATCH_CELLS cell counts on `cells`, then
+       | * stream the boxes of all cells in order on `load`, with no start. Beats
+       | * carry `cell` (index in the batch mod 2^BPACCEL_CELL_TAG_WIDTH) and
+       | * indices local to their cell; done rises when the last cell ended.
+       | * Counters sum over the batch: load_cycles = 1 + sum(n_k + 1) and
+       | * cycles = sum(cycles_k + 1) for a host that pushes the first count, then
+       | * streams one box a cycle: one cycle per batch and one per cell belong
+       | * to the batch front end. */
        |
        |#endif /* BPACCEL_PARAMS_H */
        |""".stripMargin

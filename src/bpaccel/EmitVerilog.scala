@@ -19,6 +19,7 @@ object EmitVerilog {
     memoryOutputStages: Int = AccelParams().memoryOutputStages,
     debugPort: Boolean = false,
     arch: String = AccelParams().arch.name,
+    batchCells: Int = AccelParams().batchCells,
     targetDir: Path = Paths.get("generated")
   ) {
     def params: AccelParams =
@@ -29,7 +30,8 @@ object EmitVerilog {
         queueDepth,
         memoryOutputStages,
         debugPort,
-        Arch.fromName(arch)
+        Arch.fromName(arch),
+        batchCells = batchCells
       )
   }
 
@@ -82,6 +84,9 @@ object EmitVerilog {
       opt[String]("arch")
         .action((v, o) => o.copy(arch = v))
         .text(s"architecture: ${Arch.all.map(_.name).mkString(" or ")} (default ${AccelParams().arch.name})")
+      opt[Int]("batch-cells")
+        .action((v, o) => o.copy(batchCells = v))
+        .text(s"cell counts the batch queue holds (default ${AccelParams().batchCells})")
       opt[String]("target-dir").action((v, o) => o.copy(targetDir = Paths.get(v))).text("output folder")
     }
     // Parameters are validated when the case class is built; report that as a usage error.

@@ -1,8 +1,8 @@
 package bpaccel
 
-/** Deliberate design faults, one bug each, for the formal checks' mutant
-  * tests (test/bpaccel/FormalSpec.scala): each property must fail on the
-  * fault it is meant to catch, so a passing proof is not vacuous. Only
+/** Deliberate design faults, one bug each, for the mutant tests of the formal
+  * checks (test/bpaccel/FormalSpec.scala) and of batches (BatchSpec): each
+  * check must fail on the fault it is meant to catch, so a passing proof is not vacuous. Only
   * [[AccelParams.faults]] turns one on; the default (no fault) elaborates to
   * exactly the design without them.
   */
@@ -27,6 +27,8 @@ object Fault {
   case object SkipSecondBlockAtMPlus2 extends Fault("a run of m+2 objects skips its second block")
   /** The comparators test min < max instead of min <= max: touching boxes are missed. */
   case object StrictCompare extends Fault("comparators miss touching boxes")
+  /** The batch front end does not count cells of fewer than two objects: later cells get the wrong tag. */
+  case object CellCounterSkipsShortCells extends Fault("the batch's cell counter skips cells of 0 or 1 objects")
 
   val all: Seq[Fault] = Seq(
     CreditOneTooMany,
@@ -37,6 +39,7 @@ object Fault {
     LaneMaskOneTooWide,
     RepeatLastBeat,
     SkipSecondBlockAtMPlus2,
-    StrictCompare
+    StrictCompare,
+    CellCounterSkipsShortCells
   )
 }

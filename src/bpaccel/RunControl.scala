@@ -17,10 +17,18 @@ class EngineActivity(p: AccelParams) extends Bundle {
   * objects, ends the run at once with no results. Otherwise the engine is
   * launched and the run ends once the engine is done, nothing is in flight
   * and every queued beat was taken.
+  *
+  * In a batch ([[BatchControl]]) the starts of its later cells `accumulate`:
+  * the counters add up over the batch and the first error of the batch
+  * stays; a batch's `begin` restarts the load count, dropping boxes loaded
+  * without a start, and each `frontEndCycle` counts as device time.
   */
 class RunControl(p: AccelParams) extends Module {
   val io = IO(new Bundle {
     val start      = Flipped(Decoupled(UInt(p.countWidth.W)))
+    val accumulate = Input(Bool()) // this start continues a batch
+    val batchBegin = Input(Bool()) // a batch's first count is accepted: its load time starts
+    val frontEndCycle = Input(Bool()) // a cycle the batch front end spends between cells
     val loadFire   = Input(Bool())
     val loaded     = Input(UInt(p.countWidth.W))
     val overflow   = Input(Bool())
@@ -28,7 +36,7 @@ class RunControl(p: AccelParams) extends Module {
     val engine     = Input(new EngineActivity(p))
     val queuedHits = Flipped(Valid(UInt(log2Ceil(p.m + 1).W))) // pairs entering the result queue
     val queueEmpty = Input(Bool())
-    val status     = Output(new AccelStatus(p))
+    val status     = Output(new RunStatus(p))
     val counters   = Output(new AccelCounters(p))
   })
 
@@ -51,7 +59,10 @@ class RunControl(p: AccelParams) extends Module {
 
   io.start.ready := !busy
 
-  when(io.loadFire && !loading) {
+  when(io.batchBegin) {
+    loading       := true.B
+    loadingCycles := 1.U
+  }.elsewhen(io.loadFire && !loading) {
     loading       := true.B
     loadingCycles := 1.U
   }.elsewhen(loading) {
@@ -70,19 +81,23 @@ class RunControl(p: AccelParams) extends Module {
         (n > io.loaded)        -> AccelError.CountOverLoaded
       )
     )
-    error := code
+    error := Mux(io.accumulate && error =/= AccelError.None, error, code)
     val runs = (if (p.has(Fault.ErrorStartLaunches)) true.B else code === AccelError.None) && n >= 2.U
     busy            := runs
     done            := !runs
     io.launch.valid := runs
-    loadCycles      := Mux(loading, loadingCycles + 1.U, 1.U) // + the start cycle itself
+    val runLoadCycles = Mux(loading, loadingCycles + 1.U, 1.U) // + the start cycle itself
+    loadCycles      := Mux(io.accumulate, loadCycles + runLoadCycles, runLoadCycles)
     loading         := false.B
-    cycles          := 0.U
-    issueCycles     := 0.U
-    stallCycles     := 0.U
-    hits            := 0.U
     drainCycles     := 0.U
+    when(!io.accumulate) {
+      cycles      := 0.U
+      issueCycles := 0.U
+      stallCycles := 0.U
+      hits        := 0.U
+    }
   }
+  when(io.frontEndCycle) { cycles := cycles + 1.U } // never while busy
 
   when(busy) {
     cycles := cycles + 1.U

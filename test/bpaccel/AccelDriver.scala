@@ -18,6 +18,19 @@ case class RunOutcome(
   driverCycles: Long      // clock steps the driver saw the accelerator busy after the start
 )
 
+/** What one batch returned, as the consumer saw it. */
+case class BatchOutcome(
+  pairs: Seq[(Int, Int, Int)], // (cell tag, i, j) of every beat, in arrival order
+  error: Int,
+  cellsDone: Long,
+  loadCycles: Long,
+  cycles: Long,
+  issueCycles: Long,
+  stallCycles: Long,
+  hits: Long,
+  driverCycles: Long // clock steps from the cycle that took the first count to the last busy one, both included
+)
+
 /** Drives a [[BroadPhaseAccel]] through its ports, one clock at a time. */
 class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
   private val p = dut.p
@@ -33,6 +46,7 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
   def idleInputs(): Unit = {
     dut.io.load.valid.poke(false.B)
     dut.io.start.valid.poke(false.B)
+    dut.io.cells.valid.poke(false.B)
     dut.io.result.ready.poke(false.B)
   }
 
@@ -42,10 +56,7 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
   def load(boxes: Seq[Box]): Unit = {
     for (b <- boxes) {
       dut.io.load.valid.poke(true.B)
-      for (a <- 0 until 3) {
-        dut.io.load.bits.min(a).poke(b.min(a).U(p.keyWidth.W))
-        dut.io.load.bits.max(a).poke(b.max(a).U(p.keyWidth.W))
-      }
+      pokeBox(b)
       var waited = 0
       while (!dut.io.load.ready.peek().litToBoolean) {
         step(); waited += 1
@@ -111,6 +122,69 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
       dut.io.counters.hits.peek().litValue.toLong,
       driverLoadCycles,
       cycle.toLong
+    )
+  }
+
+  private def pokeBox(b: Box): Unit =
+    for (a <- 0 until 3) {
+      dut.io.load.bits.min(a).poke(b.min(a).U(p.keyWidth.W))
+      dut.io.load.bits.max(a).poke(b.max(a).U(p.keyWidth.W))
+    }
+
+  /** Runs `cells` as one batch: offers the next count and the next box every
+    * cycle (counts first when both are offered at once, as the port wants),
+    * and plays the consumer with `ready(cycle)` until the batch is over.
+    */
+  def batch(cells: Seq[Seq[Box]], ready: Int => Boolean = _ => true): BatchOutcome = {
+    val counts = cells.map(_.length)
+    val boxes  = cells.flatten
+    var nextCount, nextBox = 0
+    var began = false
+    val pairs = Seq.newBuilder[(Int, Int, Int)]
+    var cycle, busyCycles = 0
+    while (nextCount < counts.length || nextBox < boxes.length || dut.io.status.busy.peek().litToBoolean) {
+      if (cycle >= maxCyclesPerRun) fail(s"batch of ${counts.length} cells did not finish within $maxCyclesPerRun cycles")
+      val countOffered = nextCount < counts.length
+      dut.io.cells.valid.poke(countOffered.B)
+      if (countOffered) dut.io.cells.bits.poke(counts(nextCount).U)
+      val boxOffered = nextBox < boxes.length
+      dut.io.load.valid.poke(boxOffered.B)
+      if (boxOffered) pokeBox(boxes(nextBox))
+      val r = ready(cycle)
+      dut.io.result.ready.poke(r.B)
+      if (began) busyCycles += 1
+      if (countOffered && dut.io.cells.ready.peek().litToBoolean) {
+        if (!began) { began = true; busyCycles = 1 }
+        nextCount += 1
+      }
+      if (boxOffered && dut.io.load.ready.peek().litToBoolean) nextBox += 1
+      if (r && dut.io.result.valid.peek().litToBoolean) {
+        val cell = dut.io.result.bits.cell.peek().litValue.toInt
+        val i0   = dut.io.result.bits.iBase.peek().litValue.toInt
+        val j0   = dut.io.result.bits.jBase.peek().litValue.toInt
+        val mask = dut.io.result.bits.mask.peek().litValue
+        for (k <- 0 until p.m if mask.testBit(k)) pairs += ((cell, i0 + k, j0 + k))
+      }
+      step()
+      cycle += 1
+    }
+    dut.io.cells.valid.poke(false.B)
+    dut.io.load.valid.poke(false.B)
+    dut.io.result.ready.poke(false.B)
+    if (!dut.io.status.done.peek().litToBoolean) fail("the batch ended but done did not rise")
+    if (dut.io.status.batch.peek().litToBoolean) fail("status.batch is still set after the batch")
+    if (dut.io.result.valid.peek().litToBoolean) fail("a result beat is still waiting after the batch")
+    loadSteps = None
+    BatchOutcome(
+      pairs.result(),
+      dut.io.status.error.peek().litValue.toInt,
+      dut.io.status.cellsDone.peek().litValue.toLong,
+      dut.io.counters.loadCycles.peek().litValue.toLong,
+      dut.io.counters.cycles.peek().litValue.toLong,
+      dut.io.counters.issueCycles.peek().litValue.toLong,
+      dut.io.counters.stallCycles.peek().litValue.toLong,
+      dut.io.counters.hits.peek().litValue.toLong,
+      busyCycles.toLong
     )
   }
 

@@ -29,6 +29,13 @@ class AccelParamsSpec extends AnyFlatSpec with Matchers {
     rejection(AccelParams(memoryOutputStages = 5)) should include("memoryOutputStages")
   }
 
+  it should "reject a batch queue of no cells, and size the cell tag for the queue" in {
+    rejection(AccelParams(batchCells = 0)) should include("batchCells")
+    AccelParams(batchCells = 64).cellTagWidth shouldBe 6 // tags 0..63
+    AccelParams(batchCells = 5).cellTagWidth shouldBe 3
+    AccelParams(batchCells = 1).cellTagWidth shouldBe 1
+  }
+
   it should "count every register of the pipeline in its latency" in {
     AccelParams(memoryOutputStages = 0).pipelineLatency shouldBe 3
     AccelParams().pipelineLatency shouldBe 5
@@ -58,5 +65,7 @@ class AccelParamsSpec extends AnyFlatSpec with Matchers {
     h should include("#define BPACCEL_KEY_WIDTH 32")
     h should include(s"#define BPACCEL_RUN_OVERHEAD_CYCLES ${AccelParams(m = 5, capacity = 40).runOverheadCycles}")
     h should include("#define BPACCEL_ERROR_LOAD_OVERFLOW 3")
+    h should include("#define BPACCEL_BATCH_CELLS 64")
+    h should include("#define BPACCEL_CELL_TAG_WIDTH 6")
   }
 }
