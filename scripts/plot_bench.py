@@ -127,7 +127,7 @@ def plot_timeline(rows, out, objects=8000):
     ax.set_title(
         f"{t['method']}, {t['objects']} objects, one frame: {t['frame_ms']:.3f} ms with host, link and device "
         f"overlapped (MODELLED schedule)\nvs {t['serial_ms']:.3f} ms in series as the host runs it today; "
-        f"{t['runs']} device runs",
+        f"{t.get('batches', t.get('runs'))} hand-overs to the device",
         fontsize=8,
     )
     fig.tight_layout()

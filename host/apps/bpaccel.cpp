@@ -48,7 +48,8 @@ std::optional<std::size_t> parseCellSize(const std::string& text) {
   return static_cast<std::size_t>(v);
 }
 
-int runPairs(const std::string& input, const std::string& backendName, const std::string& cellSizeText, bool stats) {
+int runPairs(const std::string& input, const std::string& backendName, const std::string& cellSizeText,
+             std::size_t cellsPerBatch, bool stats) {
   std::ifstream file(input);
   if (!file) {
     fmt::print(stderr, "bpaccel: cannot open '{}'\n", input);
@@ -62,7 +63,7 @@ int runPairs(const std::string& input, const std::string& backendName, const std
     return 1;
   }
   auto backend = makeBackend(backendName);
-  bpaccel::BroadPhase broadPhase(*backend, parseCellSize(cellSizeText));
+  bpaccel::BroadPhase broadPhase(*backend, parseCellSize(cellSizeText), cellsPerBatch);
   std::vector<bpaccel::Pair> pairs;
   broadPhase.findPairs(boxes, pairs);
   std::sort(pairs.begin(), pairs.end());
@@ -77,9 +78,9 @@ int runPairs(const std::string& input, const std::string& backendName, const std
     const auto& t = broadPhase.times();
     fmt::print(stderr,
                "backend {} cell-size {} objects {} pairs {}\n"
-               "runs {} cycles {} issue-cycles {} stall-cycles {} hits {} boxes-sent {} beats {}\n"
+               "runs {} batches {} cycles {} issue-cycles {} stall-cycles {} hits {} boxes-sent {} beats {}\n"
                "host seconds (measured): convert {:.6f} tree {:.6f} cells {:.6f} total {:.6f}\n",
-               backend->name(), cellSizeText, boxes.size(), pairs.size(), s.runs, s.cycles, s.issueCycles,
+               backend->name(), cellSizeText, boxes.size(), pairs.size(), s.runs, s.batches, s.cycles, s.issueCycles,
                s.stallCycles, s.hits, s.boxesSent, s.beatsReceived, t.convertSeconds, t.treeSeconds,
                t.cellsSeconds, t.totalSeconds);
   }
@@ -89,7 +90,7 @@ int runPairs(const std::string& input, const std::string& backendName, const std
 // The device the accelerator methods model: this program's Verilated configuration.
 std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, double clockMHz,
                                                   const std::string& fpgaReport, double linkGBytesPerSecond,
-                                                  double linkLatencyUs) {
+                                                  double linkLatencyUs, std::size_t cellsPerBatch) {
   auto device = std::make_shared<bpaccel::DeviceConfig>();
   device->backend = backend;
   device->makeBackend = [backend] { return makeBackend(backend); };
@@ -109,6 +110,8 @@ std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, do
   }
   device->link.bandwidthBytesPerSecond = linkGBytesPerSecond * 1e9;
   device->link.latencySecondsPerRun = linkLatencyUs * 1e-6;
+  device->cellsPerBatch = cellsPerBatch;
+  device->hardware["batch_cells"] = BPACCEL_BATCH_CELLS;
   return device;
 }
 
@@ -174,6 +177,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   pairs->add_option("--cell-size", cellSize, "k-d tree cell size C (most boxes a leaf holds) or 'none'")
       ->capture_default_str();
+  std::size_t pairsCellsPerBatch = 1;
+  pairs->add_option("--cells-per-batch", pairsCellsPerBatch,
+                    "Cells per hand-over to the backend (the hardware's batch front end); 1: each on its own")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   pairs->add_flag("--stats", stats, "Print cycles and timings to stderr");
 
   bpaccel::BenchConfig bench;
@@ -183,6 +190,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> benchCells = {"none", "16", "32", "64", "128", "256"};
   std::string benchBackend = "rtl", benchJson = "results/bench.json";
   double clockMHz = 0, linkGBytesPerSecond = 4, linkLatencyUs = 1;
+  std::size_t cellsPerBatch = 16;
   // The FPGA flow's report names: m<m>.json for the seed architecture, <arch>-m<m>.json otherwise.
   std::string fpgaReport = BPACCEL_ARCH_STREAM ? fmt::format("results/fpga/stream-m{}.json", BPACCEL_M)
                                                : fmt::format("results/fpga/m{}.json", BPACCEL_M);
@@ -209,8 +217,12 @@ int main(int argc, char** argv) {
   benchCmd->add_option("--link-gbytes-per-s", linkGBytesPerSecond,
                        "Modelled link bandwidth in gigabytes per second (1 GB/s = 1e9 bytes/s)")
       ->check(CLI::PositiveNumber)->capture_default_str();
-  benchCmd->add_option("--link-latency-us", linkLatencyUs, "Modelled latency per accelerator run, microseconds")
+  benchCmd->add_option("--link-latency-us", linkLatencyUs,
+                       "Modelled latency per hand-over to the accelerator (a batch of cells), microseconds")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  benchCmd->add_option("--cells-per-batch", cellsPerBatch,
+                       "Cells per hand-over to the accelerator (its batch front end); 1: each cell on its own")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   benchCmd->add_option("--whole-step-objects", bench.wholeStepObjects,
                        "Also time full stepSimulation calls with btDbvtBroadphase and bpaccel::Broadphase at this "
                        "object count (0: not)")
@@ -243,12 +255,13 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     if (*benchCmd) {
-      lineUp.device = makeDevice(benchBackend, clockMHz, fpgaReport, linkGBytesPerSecond, linkLatencyUs);
+      lineUp.device = makeDevice(benchBackend, clockMHz, fpgaReport, linkGBytesPerSecond, linkLatencyUs,
+                                 cellsPerBatch);
       return runBench(bench, lineUp, benchCells, benchJson);
     }
     if (*sceneCmd) return runScene(sceneConfig, sceneFrames, sceneOut);
     parseCellSize(cellSize);
-    return runPairs(input, backendName, cellSize, stats);
+    return runPairs(input, backendName, cellSize, pairsCellsPerBatch, stats);
   } catch (const CLI::ValidationError& e) {
     fmt::print(stderr, "bpaccel: {}\n", e.what());
     return 2;

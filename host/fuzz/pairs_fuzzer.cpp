@@ -10,8 +10,10 @@
 // Input layout (read front to back; missing bytes read as 0), so seeds can be
 // written by hand (host/fuzz/README.md):
 //   cell byte: 0 = no k-d tree, else cell size 1 + (byte - 1) % 40
-//   m byte: model lanes 1 + byte % 8, and with bit 7 set the model with the
-//   k-d tree also runs on 2 threads;  capacity byte: m * (1 + byte % (24/m + 1)), at least 2
+//   m byte: model lanes 1 + byte % 8; bits 3-4: the model's cells per hand-over
+//   1 + 3 * bits (1, 4, 7, 10); bits 5-6: its hardware batch 1 + bits cells
+//   (a hand-over beyond it is split); with bit 7 set the model with the k-d
+//   tree also runs on 2 threads;  capacity byte: m * (1 + byte % (24/m + 1)), at least 2
 //   then records: op byte < 0x30 repeats an earlier box (op % count),
 //   any other op is followed by a box: per axis two coordinates, sorted.
 //   Coordinate byte k: k < 0x60 special value kSpecial[k % 24],
@@ -191,26 +193,32 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint8_t mByte = in.byte();
   const std::size_t m = 1 + mByte % 8;
   const std::size_t threads = mByte & 0x80 ? 2 : 1;
+  const std::size_t cellsPerBatch = 1 + 3 * ((mByte >> 3) & 3u);
+  const std::size_t batchCells = 1 + ((mByte >> 5) & 3u);
   const std::size_t capacity = std::max<std::size_t>(2, m * (1 + in.byte() % (24 / m + 1)));
   const std::vector<Aabb> boxes = decodeScene(in);
 
   CpuBackend cpu;
-  ModelBackend model(m, capacity, /*runOverheadCycles=*/3);
+  ModelBackend model(m, capacity, /*runOverheadCycles=*/3, /*streamReadLatency=*/0, batchCells);
   std::vector<Setup> setups;
   std::vector<std::optional<std::size_t>> cells{std::nullopt};
   if (cell) cells.push_back(cell);
   for (const auto& c : cells) {
     const std::string cellName = c ? std::to_string(*c) : "none";
     setups.push_back({"cpu cell " + cellName, [&cpu, c] { return std::make_unique<BroadPhase>(cpu, c); }});
-    setups.push_back({fmt::format("model m {} capacity {} cell {}", m, capacity, cellName),
-                      [&model, c] { return std::make_unique<BroadPhase>(model, c); }});
+    setups.push_back({fmt::format("model m {} capacity {} cell {} batch {}/{}", m, capacity, cellName, cellsPerBatch,
+                                  batchCells),
+                      [&model, c, cellsPerBatch] { return std::make_unique<BroadPhase>(model, c, cellsPerBatch); }});
   }
   if (threads > 1 && cell) {
-    const auto makeModel = [m, capacity]() -> std::unique_ptr<Backend> {
-      return std::make_unique<ModelBackend>(m, capacity, 3);
+    const auto makeModel = [m, capacity, batchCells]() -> std::unique_ptr<Backend> {
+      return std::make_unique<ModelBackend>(m, capacity, 3, 0, batchCells);
     };
-    setups.push_back({fmt::format("model m {} capacity {} cell {} threads {}", m, capacity, *cell, threads),
-                      [makeModel, cell, threads] { return std::make_unique<BroadPhase>(makeModel, cell, threads); }});
+    setups.push_back({fmt::format("model m {} capacity {} cell {} threads {} batch {}/{}", m, capacity, *cell, threads,
+                                  cellsPerBatch, batchCells),
+                      [makeModel, cell, threads, cellsPerBatch] {
+                        return std::make_unique<BroadPhase>(makeModel, cell, threads, cellsPerBatch);
+                      }});
   }
   if (const auto bad = firstBoxWithNaN(boxes)) {
     for (const Setup& setup : setups) checkRefused(setup, boxes, *bad);

@@ -12,13 +12,13 @@ double LinkModel::seconds(const RunStats& s, std::size_t bytesPerBeat, double cl
   const double boxLink = kBytesPerBox * static_cast<double>(s.boxesSent) / bandwidthBytesPerSecond;
   const double boxPort = static_cast<double>(s.loadCycles) / clockHz;
   const double results = static_cast<double>(bytesPerBeat * s.beatsReceived) / bandwidthBytesPerSecond;
-  return static_cast<double>(s.runs) * latencySecondsPerRun + std::max(0.0, boxLink - boxPort) + results;
+  return static_cast<double>(s.batches) * latencySecondsPerRun + std::max(0.0, boxLink - boxPort) + results;
 }
 
 std::string cellName(const std::optional<std::size_t>& c) { return c ? std::to_string(*c) : "none"; }
 
 AcceleratorMethod::AcceleratorMethod(std::shared_ptr<const DeviceConfig> device, std::optional<std::size_t> cellSize)
-    : device_(std::move(device)), backend_(device_->makeBackend()), phase_(*backend_, cellSize) {}
+    : device_(std::move(device)), backend_(device_->makeBackend()), phase_(*backend_, cellSize, device_->cellsPerBatch) {}
 
 FrameTime AcceleratorMethod::frameTime(double measuredSeconds) const {
   ModelledParts p;

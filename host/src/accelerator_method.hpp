@@ -19,14 +19,14 @@ namespace bpaccel {
 /// Modelled link between host and accelerator. Boxes stream through the
 /// device's load port, one 24-byte box a cycle, while they arrive: the load
 /// cycles are device time, and the link adds only what it is slower than the
-/// port. Each run pays a latency (command and completion); result beats come
-/// back over the link.
-///   transfer = runs * latency + max(0, box bytes / bandwidth - load cycles / clock)
+/// port. Each hand-over (a batch of cells, or a single run) pays a latency
+/// (command and completion); result beats come back over the link.
+///   transfer = hand-overs * latency + max(0, box bytes / bandwidth - load cycles / clock)
 ///            + result bytes / bandwidth
 struct LinkModel {
   static constexpr double kBytesPerBox = 24;
   double bandwidthBytesPerSecond = 4e9;  // a PCIe Gen3 x4 link's order of magnitude
-  double latencySecondsPerRun = 1e-6;    // one command and one completion per run
+  double latencySecondsPerRun = 1e-6;    // one command and one completion per hand-over
   double seconds(const RunStats& s, std::size_t bytesPerBeat, double clockHz) const;
 };
 
@@ -53,6 +53,9 @@ struct DeviceConfig {
   double clockHz = 100e6;
   std::string clockSource = "default 100 MHz";
   LinkModel link;
+  /// Cells per hand-over to the device (the hardware's batch front end);
+  /// 1 hands each cell over on its own, as before batches existed.
+  std::size_t cellsPerBatch = 1;
 };
 
 /// BroadPhase on the device: host part measured, device and link modelled.

@@ -56,7 +56,7 @@ struct Entry {
   std::optional<std::string> skipped;
   double setupSeconds = 0, updateSeconds = 0;
   std::vector<double> frameSeconds, hostSeconds, deviceSeconds, transferSeconds;
-  std::vector<double> deviceCycles, loadCycles, cycles, runs, boxesSent;
+  std::vector<double> deviceCycles, loadCycles, cycles, runs, batches, boxesSent;
   std::vector<double> pipelinedSeconds;           // modelled overlap of the same frames
   std::shared_ptr<const FrameTimeline> timeline;  // the last timed frame's, for the plot
   double timelineSerialSeconds = 0;
@@ -118,9 +118,10 @@ nlohmann::json describe(const LineUpConfig& config) {
     j["clock_source"] = d->clockSource;
     j["link_model"] = {{"bandwidth_bytes_per_second", d->link.bandwidthBytesPerSecond},
                        {"latency_seconds_per_run", d->link.latencySecondsPerRun},
+                       {"cells_per_batch", d->cellsPerBatch},
                        {"bytes_per_box", LinkModel::kBytesPerBox},
                        {"bytes_per_result_beat", d->beatBytes},
-                       {"formula", "transfer = runs * latency + max(0, box bytes / bandwidth - load cycles / clock) "
+                       {"formula", "transfer = batches * latency + max(0, box bytes / bandwidth - load cycles / clock) "
                                    "+ result bytes / bandwidth; device = (load + compute + drain cycles) / clock"}};
   }
   return j;
@@ -190,7 +191,7 @@ nlohmann::json timelineJson(const std::vector<Entry>& entries, std::size_t objec
   };
   return {{"method", best->spec->name},
           {"objects", objects},
-          {"runs", t.device.size()},
+          {"batches", t.device.size()},
           {"frame_ms", t.frameSeconds * 1e3},
           {"serial_ms", best->timelineSerialSeconds * 1e3},
           {"what", "one frame: host work measured (producer = keys, tree, packing; decoder = decoding and filtering), "
@@ -325,6 +326,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
         e.loadCycles.push_back(static_cast<double>(p->stats.loadCycles));
         e.cycles.push_back(static_cast<double>(p->stats.cycles));
         e.runs.push_back(static_cast<double>(p->stats.runs));
+        e.batches.push_back(static_cast<double>(p->stats.batches));
         e.boxesSent.push_back(static_cast<double>(p->stats.boxesSent));
         if (p->pipeline) {
           e.pipelinedSeconds.push_back(p->pipeline->frameSeconds);
@@ -401,6 +403,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
       j["load_cycles"] = summary(e.loadCycles, 1);
       j["cycles"] = summary(e.cycles, 1);
       j["runs"] = summary(e.runs, 1);
+      j["batches"] = summary(e.batches, 1);
       j["boxes_sent"] = summary(e.boxesSent, 1);
       j["serial_frame_ms"] = summary(e.frameSeconds, 1e3);
       j["pipelined_frame_ms_modelled"] = summary(e.pipelinedSeconds, 1e3);
@@ -470,11 +473,12 @@ std::string Benchmark::table(const nlohmann::json& results) {
   if (cfg.contains("clock_hz"))
     legend = fmt::format(
         "accelerator = measured host + modelled device ({:.1f} MHz, device cycles with loads, {} backend) + modelled "
-        "transfer ({:.1f} GB/s, {:.1f} us per run; boxes stream through the 24-byte-a-cycle load port, so only the "
-        "link's excess over the load cycles counts)",
+        "transfer ({:.1f} GB/s, {:.1f} us per hand-over of up to {} cells; boxes stream through the "
+        "24-byte-a-cycle load port, so only the link's excess over the load cycles counts)",
         cfg["clock_hz"].get<double>() / 1e6, cfg["accelerator_backend"].get<std::string>(),
         cfg["link_model"]["bandwidth_bytes_per_second"].get<double>() / 1e9,
-        cfg["link_model"]["latency_seconds_per_run"].get<double>() * 1e6);
+        cfg["link_model"]["latency_seconds_per_run"].get<double>() * 1e6,
+        cfg["link_model"].value("cells_per_batch", std::size_t{1}));
   header("Median broad-phase time per frame, ms, one thread unless named (" + legend +
          "; ! = missed exact pairs; - = skipped, see below)");
   for (const auto& name : names) {
@@ -491,7 +495,8 @@ std::string Benchmark::table(const nlohmann::json& results) {
   }
 
   header("Accelerator frame with host, link and device overlapped, ms: MODELLED schedule of the same measured "
-         "host work (one host thread produces runs, one decodes; the host code runs them in series today, as above)");
+         "host work (one host thread produces batches, one decodes; the host code runs them in series today, as "
+         "above)");
   for (const auto& name : names) {
     if (kindOf(name) != "accelerator") continue;
     t += pad(name, kName);

@@ -24,18 +24,41 @@ enum Keep : int { kCross = 1, kFirstInside = 2, kSecondInside = 4 };
 struct BroadPhase::Worker {
   std::unique_ptr<Backend> owned;
   Backend* backend = nullptr;
+  std::size_t cellsPerBatch = 1;
   std::vector<KeyBox> gathered;         // a chunk pair's boxes, packed for the backend
-  std::vector<Pair> local;              // pairs of one run, batch indices
+  std::vector<Pair> local;              // pairs of one hand-over, indices local to each cell
   std::vector<Pair> out;                // this worker's share of the frame's pairs
   RunStats stats;
   double backendSeconds = 0;
   Clock::time_point frameStart;
   std::vector<RunRecord> runs;
 
-  // `packed`: the cell's boxes in item order when the caller has them (the
-  // tree's leaves, the whole scene), else empty: they are gathered from `keys`.
-  void runBatch(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-                const KdTree::Leaf* region, std::size_t splitAt, int keep);
+  // The batch being filled: its cells' items and boxes back to back, and how
+  // to filter each cell's pairs. A cell's region is copied: the tree's leaf
+  // list grows (and moves) while the batch fills.
+  struct PendingCell {
+    std::size_t begin = 0, count = 0;
+    KdTree::Leaf region{};
+    bool hasRegion = false;
+    std::size_t splitAt = 0;
+    int keep = 0;
+  };
+  std::vector<PendingCell> pending;
+  std::vector<std::uint32_t> pendingItems;
+  std::vector<KeyBox> pendingBoxes;
+  std::vector<std::span<const KeyBox>> cellSpans;
+  std::vector<std::size_t> cellEnds;
+
+  // One device cell: a tree cell or a chunk pair. `packed`: its boxes in item
+  // order when the caller has them (the tree's leaves, the whole scene), else
+  // empty: they are gathered from `keys`.
+  void submit(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
+              const KdTree::Leaf* region, std::size_t splitAt, int keep);
+  void runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
+              const KdTree::Leaf* region, std::size_t splitAt, int keep);
+  void flush();  // hands the pending batch over, if any
+  void keepPairs(std::span<const Pair> pairs, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
+                 const KdTree::Leaf* region, std::size_t splitAt, int keep);
   void processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
                    const KdTree::Leaf* region, std::size_t capacity);
 };
@@ -54,16 +77,17 @@ class BroadPhase::Pool {
   tbb::task_arena arena_;
 };
 
-BroadPhase::BroadPhase(Backend& backend, std::optional<std::size_t> cellSize)
-    : cellSize_(cellSize), capacity_(backend.capacity()) {
+BroadPhase::BroadPhase(Backend& backend, std::optional<std::size_t> cellSize, std::size_t cellsPerBatch)
+    : cellSize_(cellSize), cellsPerBatch_(cellsPerBatch), capacity_(backend.capacity()) {
   auto w = std::make_unique<Worker>();
   w->backend = &backend;
   workers_.push_back(std::move(w));
-  check();
+  configureWorkers();
 }
 
-BroadPhase::BroadPhase(const BackendFactory& makeBackend, std::optional<std::size_t> cellSize, std::size_t threads)
-    : cellSize_(cellSize) {
+BroadPhase::BroadPhase(const BackendFactory& makeBackend, std::optional<std::size_t> cellSize, std::size_t threads,
+                       std::size_t cellsPerBatch)
+    : cellSize_(cellSize), cellsPerBatch_(cellsPerBatch) {
   if (threads < 1) throw std::invalid_argument("broad phase: at least one thread");
   for (std::size_t t = 0; t < threads; ++t) {
     auto w = std::make_unique<Worker>();
@@ -74,7 +98,12 @@ BroadPhase::BroadPhase(const BackendFactory& makeBackend, std::optional<std::siz
   }
   capacity_ = workers_.front()->backend->capacity();
   if (threads > 1) pool_ = std::make_unique<Pool>(threads);
+  configureWorkers();
+}
+
+void BroadPhase::configureWorkers() {
   check();
+  for (auto& w : workers_) w->cellsPerBatch = cellsPerBatch_;
 }
 
 BroadPhase::~BroadPhase() = default;
@@ -82,6 +111,7 @@ BroadPhase::~BroadPhase() = default;
 void BroadPhase::check() const {
   if (cellSize_ && *cellSize_ < 1) throw std::invalid_argument("cell size must be at least 1");
   if (capacity_ < 2) throw std::invalid_argument("backend capacity must be at least 2");
+  if (cellsPerBatch_ < 1) throw std::invalid_argument("cells per batch must be at least 1");
 }
 
 void BroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) {
@@ -105,6 +135,7 @@ void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out)
     identity_.resize(keys.size());
     std::iota(identity_.begin(), identity_.end(), 0u);
     workers_.front()->processCell(keys, identity_, keys, nullptr, capacity_);
+    workers_.front()->flush();
     times_.cellsSeconds = seconds(t0, Clock::now());
   } else if (!pool_) {
     streamCells(keys);
@@ -127,6 +158,9 @@ void BroadPhase::streamCells(std::span<const KeyBox> keys) {
     w.processCell(keys, items, packed, &leaf, capacity_);
     inCells += seconds(c0, Clock::now());
   });
+  const auto f0 = Clock::now();
+  w.flush();  // the last, partly filled batch
+  inCells += seconds(f0, Clock::now());
   times_.cellsSeconds = inCells;
   times_.treeSeconds = seconds(t0, Clock::now()) - inCells;
 }
@@ -156,6 +190,9 @@ void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys) {
     });
     built = Clock::now();
     tasks.wait();
+    // Each worker's last, partly filled batch; no task runs any more, so
+    // this thread may use every worker's backend.
+    for (auto& w : workers_) w->flush();
   });
   times_.treeSeconds = seconds(t0, built);
   times_.cellsSeconds = seconds(built, Clock::now());
@@ -168,6 +205,9 @@ void BroadPhase::startCells(Clock::time_point frameStart) {
     w->backendSeconds = 0;
     w->frameStart = frameStart;
     w->runs.clear();
+    w->pending.clear();  // left over only if a hand-over failed
+    w->pendingItems.clear();
+    w->pendingBoxes.clear();
   }
 }
 
@@ -190,7 +230,7 @@ void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<con
                                      std::size_t capacity) {
   if (items.size() < 2) return;
   if (items.size() <= capacity) {
-    runBatch(keys, items, packed, region, items.size(), kFirstInside);
+    submit(keys, items, packed, region, items.size(), kFirstInside);
     return;
   }
   const std::size_t chunk = capacity / 2;
@@ -205,14 +245,68 @@ void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<con
       int keep = kCross;
       if (q == p + 1) keep |= kFirstInside;
       if (p == k - 2 && q == k - 1) keep |= kSecondInside;
-      runBatch(keys, pairItems, {}, region, first.size(), keep);
+      submit(keys, pairItems, {}, region, first.size(), keep);
     }
   }
 }
 
-void BroadPhase::Worker::runBatch(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
-                                  std::span<const KeyBox> packed, const KdTree::Leaf* region, std::size_t splitAt,
-                                  int keep) {
+void BroadPhase::Worker::submit(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
+                                std::span<const KeyBox> packed, const KdTree::Leaf* region, std::size_t splitAt,
+                                int keep) {
+  if (cellsPerBatch <= 1) {
+    runNow(keys, items, packed, region, splitAt, keep);
+    return;
+  }
+  PendingCell cell;
+  cell.begin = pendingItems.size();
+  cell.count = items.size();
+  if (region) cell.region = *region;
+  cell.hasRegion = region != nullptr;
+  cell.splitAt = splitAt;
+  cell.keep = keep;
+  pendingItems.insert(pendingItems.end(), items.begin(), items.end());
+  if (packed.empty())
+    for (const std::uint32_t id : items) pendingBoxes.push_back(keys[id]);
+  else
+    pendingBoxes.insert(pendingBoxes.end(), packed.begin(), packed.end());
+  pending.push_back(cell);
+  if (pending.size() >= cellsPerBatch) flush();
+}
+
+void BroadPhase::Worker::flush() {
+  if (pending.empty()) return;
+  cellSpans.clear();
+  for (const PendingCell& c : pending) cellSpans.push_back(std::span<const KeyBox>(pendingBoxes).subspan(c.begin, c.count));
+  local.clear();
+  cellEnds.clear();
+  RunRecord record;
+  const auto ready = Clock::now();
+  record.readySeconds = seconds(frameStart, ready) - backendSeconds;
+  backend->runBatch(cellSpans, local, cellEnds, record.stats);
+  const auto ran = Clock::now();
+  backendSeconds += seconds(ready, ran);
+  if (cellEnds.size() != pending.size() || (!cellEnds.empty() && cellEnds.back() != local.size()))
+    throw std::logic_error(fmt::format("broad phase: backend {} returned {} cell ends for a batch of {} cells",
+                                       backend->name(), cellEnds.size(), pending.size()));
+  stats += record.stats;
+  std::size_t from = 0;
+  for (std::size_t c = 0; c < pending.size(); ++c) {
+    const PendingCell& cell = pending[c];
+    keepPairs(std::span<const Pair>(local).subspan(from, cellEnds[c] - from),
+              std::span<const std::uint32_t>(pendingItems).subspan(cell.begin, cell.count), cellSpans[c],
+              cell.hasRegion ? &cell.region : nullptr, cell.splitAt, cell.keep);
+    from = cellEnds[c];
+  }
+  record.decodeSeconds = seconds(ran, Clock::now());
+  runs.push_back(record);
+  pending.clear();
+  pendingItems.clear();
+  pendingBoxes.clear();
+}
+
+void BroadPhase::Worker::runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
+                                std::span<const KeyBox> packed, const KdTree::Leaf* region, std::size_t splitAt,
+                                int keep) {
   if (packed.empty()) {
     gathered.resize(items.size());
     for (std::size_t t = 0; t < items.size(); ++t) gathered[t] = keys[items[t]];
@@ -226,7 +320,18 @@ void BroadPhase::Worker::runBatch(std::span<const KeyBox> keys, std::span<const 
   const auto ran = Clock::now();
   backendSeconds += seconds(ready, ran);
   stats += record.stats;
-  for (const auto& [a, b] : local) {
+  keepPairs(local, items, packed, region, splitAt, keep);
+  record.decodeSeconds = seconds(ran, Clock::now());
+  runs.push_back(record);
+}
+
+// Keeps the pairs of one device cell that this cell owns: the kinds `keep`
+// asks for (a chunk pair's cross pairs, or the inside pairs of one chunk),
+// and only those whose reference point lies in the cell's region.
+void BroadPhase::Worker::keepPairs(std::span<const Pair> pairs, std::span<const std::uint32_t> items,
+                                   std::span<const KeyBox> packed, const KdTree::Leaf* region, std::size_t splitAt,
+                                   int keep) {
+  for (const auto& [a, b] : pairs) {
     const bool firstA = a < splitAt, firstB = b < splitAt;
     const int kind = firstA != firstB ? kCross : (firstA ? kFirstInside : kSecondInside);
     if (!(keep & kind)) continue;
@@ -234,8 +339,6 @@ void BroadPhase::Worker::runBatch(std::span<const KeyBox> keys, std::span<const 
     const std::uint32_t i = items[a], j = items[b];
     out.emplace_back(std::min(i, j), std::max(i, j));
   }
-  record.decodeSeconds = seconds(ran, Clock::now());
-  runs.push_back(record);
 }
 
 }  // namespace bpaccel

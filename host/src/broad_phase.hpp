@@ -36,14 +36,22 @@ struct HostTimes {
 /// shared out among workers as tasks, each worker with a backend of its own
 /// from the factory (backends keep scratch state and are not shared between
 /// threads).
+///
+/// `cellsPerBatch` > 1 hands cells to the backend in batches
+/// (Backend::runBatch): each worker copies the cells it is given, packed,
+/// into the batch it is filling and hands it over when it holds that many
+/// cells, and at the end of the frame. One batch is one hand-over to the
+/// device (one link latency). With 1, each cell is handed over on its own,
+/// straight from the tree's storage.
 class BroadPhase {
  public:
   using BackendFactory = std::function<std::unique_ptr<Backend>()>;
 
   /// One thread, on `backend`.
-  BroadPhase(Backend& backend, std::optional<std::size_t> cellSize);
+  BroadPhase(Backend& backend, std::optional<std::size_t> cellSize, std::size_t cellsPerBatch = 1);
   /// `threads` workers (at least 1), each with its own backend.
-  BroadPhase(const BackendFactory& makeBackend, std::optional<std::size_t> cellSize, std::size_t threads);
+  BroadPhase(const BackendFactory& makeBackend, std::optional<std::size_t> cellSize, std::size_t threads,
+             std::size_t cellsPerBatch = 1);
   ~BroadPhase();
   BroadPhase(const BroadPhase&) = delete;
   BroadPhase& operator=(const BroadPhase&) = delete;
@@ -57,9 +65,11 @@ class BroadPhase {
   const HostTimes& times() const { return times_; }
   const KdTree& tree() const { return tree_; }
   std::size_t threads() const { return workers_.size(); }
-  /// The last call's backend runs in order, with the measured host time at
-  /// which each was ready and its decoding took (for modelPipeline). With
-  /// several threads, each worker's runs follow the previous worker's.
+  std::size_t cellsPerBatch() const { return cellsPerBatch_; }
+  /// The last call's hand-overs to the backend (batches, or single runs) in
+  /// order, with the measured host time at which each was ready and its
+  /// decoding took (for modelPipeline). With several threads, each worker's
+  /// hand-overs follow the previous worker's.
   const std::vector<RunRecord>& runs() const { return runs_; }
 
  private:
@@ -70,10 +80,12 @@ class BroadPhase {
   void startCells(std::chrono::steady_clock::time_point frameStart);  // clears the workers' results
   void finishCells(std::vector<Pair>& out);                            // gathers them
   void check() const;
+  void configureWorkers();
 
   std::vector<std::unique_ptr<Worker>> workers_;
   std::unique_ptr<Pool> pool_;  // only with more than one worker
   std::optional<std::size_t> cellSize_;
+  std::size_t cellsPerBatch_;
   std::size_t capacity_;
   KdTree tree_;
   std::vector<KeyBox> keys_;

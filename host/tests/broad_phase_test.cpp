@@ -395,3 +395,54 @@ TEST(BroadPhase, ScenesLargerThanTheCarryThresholdAreExactOnOneAndTwoThreads) {
   two.findPairs(boxes, pairs);
   EXPECT_EQ(sorted(pairs), exact);
 }
+
+TEST(BroadPhase, BatchesOfCellsGiveExactlyThePairsOfSingleRunsWithTheSameCycles) {
+  // A small capacity, so that chunk pairs of oversized cells travel in batches too.
+  for (std::size_t capacity : {6u, 64u}) {
+    ModelBackend model(2, capacity, 5);
+    for (std::size_t n : {0u, 2u, 300u, 1000u})
+      for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 3))
+        for (const auto& cell : {std::optional<std::size_t>{}, std::optional<std::size_t>{4},
+                                 std::optional<std::size_t>{16}}) {
+          const std::string label = name + " capacity " + std::to_string(capacity) + " cell " +
+                                    (cell ? std::to_string(*cell) : "none");
+          BroadPhase single(model, cell, 1);
+          std::vector<Pair> expected;
+          single.findPairs(boxes, expected);
+          EXPECT_EQ(sorted(expected), bruteForce(boxes)) << label;
+          EXPECT_EQ(single.stats().batches, single.stats().runs) << label;
+          // 1000 is more than the model's hardware batch (64 cells): it splits the hand-over.
+          for (std::size_t perBatch : {2u, 7u, 64u, 1000u}) {
+            BroadPhase batched(model, cell, perBatch);
+            std::vector<Pair> pairs;
+            batched.findPairs(boxes, pairs);
+            EXPECT_EQ(sorted(pairs), sorted(expected)) << label << " per batch " << perBatch;
+            const RunStats& s = batched.stats();
+            EXPECT_EQ(s.runs, single.stats().runs) << label;
+            const std::size_t handOver = std::min<std::size_t>(perBatch, 64);
+            if (perBatch <= 64)
+              EXPECT_EQ(s.batches, (s.runs + handOver - 1) / handOver) << label << " per batch " << perBatch;
+            else
+              EXPECT_GE(s.batches, (s.runs + handOver - 1) / handOver) << label << " per batch " << perBatch;
+            EXPECT_EQ(batched.runs().size(), (s.runs + perBatch - 1) / perBatch) << label;
+            // The same cells on the same device: the same pair tests and loads.
+            EXPECT_EQ(s.issueCycles, single.stats().issueCycles) << label;
+            EXPECT_EQ(s.boxesSent, single.stats().boxesSent) << label;
+            EXPECT_EQ(s.hits, single.stats().hits) << label;
+          }
+        }
+  }
+}
+
+TEST(BroadPhase, BatchesWorkOnSeveralThreadsAndRejectZeroCellsPerBatch) {
+  BroadPhase model([] { return std::make_unique<ModelBackend>(2, 6, 5); }, 16, 2, 5);
+  for (std::size_t n : {0u, 2u, 300u, 1000u})
+    for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 9)) {
+      std::vector<Pair> pairs;
+      model.findPairs(boxes, pairs);
+      EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << name;
+      EXPECT_LE(model.stats().batches, model.stats().runs) << name;
+    }
+  ModelBackend m(2, 6, 5);
+  EXPECT_THROW(BroadPhase(m, 16, 0), std::invalid_argument);
+}

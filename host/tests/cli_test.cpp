@@ -52,6 +52,18 @@ TEST(Cli, PrintsSortedPairsForEveryBackendAndCellSize) {
     }
 }
 
+TEST(Cli, BatchesOfCellsGiveTheSamePairsAsSingleRuns) {
+  for (const char* backend : {"rtl", "model", "cpu"})
+    for (const char* batch : {"1", "2", "3", "100"}) {
+      const auto r = runCli(kScene, std::string("--backend ") + backend + " --cell-size 1 --cells-per-batch " + batch);
+      EXPECT_EQ(r.exitCode, 0) << r.err;
+      EXPECT_EQ(r.out, "0 1\n0 3\n") << backend << " " << batch;
+    }
+  const auto r = runCli(kScene, "--backend rtl --cell-size 1 --cells-per-batch 100 --stats");
+  EXPECT_NE(r.err.find("batches 1 "), std::string::npos) << r.err;
+  EXPECT_NE(runCli(kScene, "--cells-per-batch 0").exitCode, 0);
+}
+
 TEST(Cli, StatsGoToStderr) {
   const auto r = runCli(kScene, "--backend rtl --stats");
   EXPECT_EQ(r.exitCode, 0);
