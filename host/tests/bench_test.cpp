@@ -180,7 +180,7 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
       EXPECT_EQ(m["acceleration_over"].size(), 9u);
       if (m["kind"] == "accelerator")
         for (const char* part : {"host_ms_measured", "device_ms_modelled", "transfer_ms_modelled", "device_cycles",
-                                 "load_cycles", "runs", "serial_frame_ms", "pipelined_frame_ms_modelled"})
+                                 "load_cycles", "runs", "batches", "serial_frame_ms", "pipelined_frame_ms_modelled"})
           EXPECT_TRUE(m.contains(part)) << part;
       if (m["kind"] == "accelerator") {
         // Overlapping can hide host and link time, never the device's own busy cycles.
@@ -190,10 +190,10 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
         EXPECT_EQ(m["serial_frame_ms"], m["frame_ms"]) << m["name"];
       }
     }
-    // The timeline of the row's best accelerator method: one device span per run.
+    // The timeline of the row's best accelerator method: one device span per hand-over.
     const auto& tl = row["timeline"];
     ASSERT_TRUE(tl.is_object());
-    EXPECT_EQ(tl["lanes"]["device"].size(), tl["runs"].get<std::size_t>());
+    EXPECT_EQ(tl["lanes"]["device"].size(), tl["batches"].get<std::size_t>());
     EXPECT_GT(tl["frame_ms"].get<double>(), 0);
     for (const char* lane : {"produce", "link", "device", "decode"}) EXPECT_TRUE(tl["lanes"].contains(lane)) << lane;
   }
@@ -368,7 +368,8 @@ TEST(CompareSorted, CountsMissingAndExtraPairs) {
 TEST(LinkModel, ALinkSlowerThanTheLoadPortAddsOnlyItsExcess) {
   LinkModel link{1e9, 2e-6};  // 1 GB/s: 24 kB of boxes take 24 us
   RunStats s;
-  s.runs = 3;
+  s.runs = 30;    // cells: they do not pay the latency ...
+  s.batches = 3;  // ... hand-overs do
   s.boxesSent = 1000;
   s.loadCycles = 1000;  // 10 us at 100 MHz through the load port
   s.beatsReceived = 500;
@@ -379,6 +380,7 @@ TEST(LinkModel, ALinkFasterThanTheLoadPortAddsNothingForBoxes) {
   LinkModel link{100e9, 1e-6};  // 24 kB in 0.24 us, the port needs 10 us: the loads (device time) dominate
   RunStats s;
   s.runs = 1;
+  s.batches = 1;
   s.boxesSent = 1000;
   s.loadCycles = 1000;
   s.beatsReceived = 0;
@@ -397,6 +399,32 @@ TEST(AcceleratorMethod, DeviceTimeCountsLoadCycles) {
   EXPECT_DOUBLE_EQ(t.parts->deviceSeconds,
                    static_cast<double>(t.parts->stats.loadCycles + t.parts->stats.cycles) / 100e6);
   EXPECT_GT(t.parts->stats.cycles, 0u);
+}
+
+TEST(AcceleratorMethod, BatchesPayTheLinkLatencyOncePerHandOverAndFindTheSamePairs) {
+  const auto boxes = bpaccel::testing::adversarialScenes(1500, 4)[0].second;
+  const auto frame = [&](std::size_t cellsPerBatch, std::vector<Pair>& pairs) {
+    auto d = std::make_shared<DeviceConfig>();
+    d->makeBackend = [] { return std::make_unique<ModelBackend>(modelOfBuiltHardware()); };
+    d->clockHz = 100e6;
+    d->link.bandwidthBytesPerSecond = 1e12;  // the load port is slower: boxes add no link time
+    d->link.latencySecondsPerRun = 1e-6;
+    d->cellsPerBatch = cellsPerBatch;
+    AcceleratorMethod method(d, 16);
+    method.update(boxes);
+    method.pairs(pairs);
+    return *method.frameTime(0.0).parts;
+  };
+  std::vector<Pair> single, batched;
+  const ModelledParts one = frame(1, single), eight = frame(8, batched);
+  EXPECT_EQ(bpaccel::testing::sorted(batched), bpaccel::testing::sorted(single));
+  EXPECT_EQ(one.stats.batches, one.stats.runs);
+  ASSERT_GT(one.stats.runs, 16u);
+  EXPECT_EQ(eight.stats.runs, one.stats.runs);
+  EXPECT_EQ(eight.stats.batches, (one.stats.runs + 7) / 8);
+  EXPECT_EQ(eight.stats.issueCycles, one.stats.issueCycles);
+  EXPECT_NEAR(one.transferSeconds - eight.transferSeconds,
+              static_cast<double>(one.stats.batches - eight.stats.batches) * 1e-6, 1e-12);
 }
 
 TEST(DeviceClock, TheDefaultClockIsTheFmaxOfAReportOfTheSameMAndArchitectureOnly) {
