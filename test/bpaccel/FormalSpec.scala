@@ -116,6 +116,14 @@ class FormalSpec extends AnyFlatSpec with ChiselScalatestTester with Formal with
       prove(s"stream-m$m-c$c-k$k", params(Arch.Stream, m, c), k)
     }
 
+  // The same 5 cycles as make test's check for every m up to 4 (capacity
+  // m + 1: one block and its successor's first object): loads in any order,
+  // error and short starts and the start of a run, with m lanes.
+  for (m <- 2 to 4)
+    it should s"keep every property for m=$m, capacity=${m + 1} over 5 cycles" taggedAs FormalLong in {
+      prove(s"stream-m$m-c${m + 1}-k5", params(Arch.Stream, m, m + 1), 5)
+    }
+
   behavior of "each property on a mutant"
 
   // fault, the property that must catch it, m, capacity, depth (the check stops at the first failure)
