@@ -57,6 +57,10 @@ struct BroadPhase::Worker {
   void runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
               const KdTree::Leaf* region, std::size_t splitAt, int keep);
   void flush();  // hands the pending batch over, if any
+  // One hand-over to the backend (`run` fills the record's counters), timed
+  // and recorded for the pipeline model, then `decode` of its pairs.
+  template <typename Run, typename Decode>
+  void handOver(Run&& run, Decode&& decode);
   void keepPairs(std::span<const Pair> pairs, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
                  const KdTree::Leaf* region, std::size_t splitAt, int keep);
   void processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
@@ -279,26 +283,23 @@ void BroadPhase::Worker::flush() {
   for (const PendingCell& c : pending) cellSpans.push_back(std::span<const KeyBox>(pendingBoxes).subspan(c.begin, c.count));
   local.clear();
   cellEnds.clear();
-  RunRecord record;
-  const auto ready = Clock::now();
-  record.readySeconds = seconds(frameStart, ready) - backendSeconds;
-  backend->runBatch(cellSpans, local, cellEnds, record.stats);
-  const auto ran = Clock::now();
-  backendSeconds += seconds(ready, ran);
-  if (cellEnds.size() != pending.size() || (!cellEnds.empty() && cellEnds.back() != local.size()))
-    throw std::logic_error(fmt::format("broad phase: backend {} returned {} cell ends for a batch of {} cells",
-                                       backend->name(), cellEnds.size(), pending.size()));
-  stats += record.stats;
-  std::size_t from = 0;
-  for (std::size_t c = 0; c < pending.size(); ++c) {
-    const PendingCell& cell = pending[c];
-    keepPairs(std::span<const Pair>(local).subspan(from, cellEnds[c] - from),
-              std::span<const std::uint32_t>(pendingItems).subspan(cell.begin, cell.count), cellSpans[c],
-              cell.hasRegion ? &cell.region : nullptr, cell.splitAt, cell.keep);
-    from = cellEnds[c];
-  }
-  record.decodeSeconds = seconds(ran, Clock::now());
-  runs.push_back(record);
+  handOver(
+      [&](RunStats& runStats) {
+        backend->runBatch(cellSpans, local, cellEnds, runStats);
+        if (cellEnds.size() != pending.size() || (!cellEnds.empty() && cellEnds.back() != local.size()))
+          throw std::logic_error(fmt::format("broad phase: backend {} returned {} cell ends for a batch of {} cells",
+                                             backend->name(), cellEnds.size(), pending.size()));
+      },
+      [&] {
+        std::size_t from = 0;
+        for (std::size_t c = 0; c < pending.size(); ++c) {
+          const PendingCell& cell = pending[c];
+          keepPairs(std::span<const Pair>(local).subspan(from, cellEnds[c] - from),
+                    std::span<const std::uint32_t>(pendingItems).subspan(cell.begin, cell.count), cellSpans[c],
+                    cell.hasRegion ? &cell.region : nullptr, cell.splitAt, cell.keep);
+          from = cellEnds[c];
+        }
+      });
   pending.clear();
   pendingItems.clear();
   pendingBoxes.clear();
@@ -313,14 +314,20 @@ void BroadPhase::Worker::runNow(std::span<const KeyBox> keys, std::span<const st
     packed = gathered;
   }
   local.clear();
+  handOver([&](RunStats& runStats) { backend->run(packed, local, runStats); },
+           [&] { keepPairs(local, items, packed, region, splitAt, keep); });
+}
+
+template <typename Run, typename Decode>
+void BroadPhase::Worker::handOver(Run&& run, Decode&& decode) {
   RunRecord record;
   const auto ready = Clock::now();
   record.readySeconds = seconds(frameStart, ready) - backendSeconds;
-  backend->run(packed, local, record.stats);
+  run(record.stats);
   const auto ran = Clock::now();
   backendSeconds += seconds(ready, ran);
   stats += record.stats;
-  keepPairs(local, items, packed, region, splitAt, keep);
+  decode();
   record.decodeSeconds = seconds(ran, Clock::now());
   runs.push_back(record);
 }
