@@ -63,7 +63,9 @@ class BatchControl(p: AccelParams) extends Module {
   io.loadReady   := wantsBox
   io.start.valid := loading && !wantsBox
   io.start.bits  := current
-  io.accumulate  := active && cellsDone =/= 0.U
+  // A register, not cellsDone =/= 0: a 32-bit test in front of every counter's enable was the next m = 8 critical path.
+  val cellEnded = RegInit(false.B) // a cell of this batch has ended
+  io.accumulate := active && cellEnded
   when(io.loadFire && wantsBox) {
     left     := left - 1.U
     wantsBox := left =/= 1.U
@@ -82,13 +84,15 @@ class BatchControl(p: AccelParams) extends Module {
   // The deliberate bug of the batch mutant test: cells of fewer than two objects are not counted.
   val counted = if (p.has(Fault.CellCounterSkipsShortCells)) current >= 2.U else true.B
   when(cellEnd) {
-    running := false.B
+    running   := false.B
+    cellEnded := true.B
     when(counted) { cellsDone := cellsDone + 1.U }
     when(!tail.valid) { active := false.B }
   }
   when(io.begin) {
     active    := true.B
     cellsDone := 0.U
+    cellEnded := false.B
   }
 
   io.active    := active
