@@ -39,9 +39,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   }
   private def tagOf(index: UInt): UInt = if (p.debugPort) index else 0.U(0.W)
 
-  // ---- coordinate memory: one row of six keys per object ----
-  val mem = SyncReadMem(p.capacity, UInt(W.W))
-  when(io.write.valid) { mem.write(io.write.bits.index, io.write.bits.box.asUInt) }
 
   // ---- run state ----
   val n        = Reg(UInt(p.countWidth.W))
@@ -95,11 +92,31 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       rHasNextBlock := rBlockLeft >= (2 * m).U
     } // past the last block the stream is never compared: hold
   }
+  // ---- coordinate memory: one row of six keys per object ----
   val read = Wire(Valid(new Entry))
   read.valid    := RegNext(readEvent, false.B)
-  read.bits.box := mem.read(rObj, readEvent)
   read.bits.tag := RegNext(tagOf(rObj))
-  val readStages = Seq.iterate(read, p.memoryOutputStages + 1)(x => Pipe(x))
+  // The read, then memoryOutputStages registers; the first may sit in the block RAM.
+  val readStages = p.memoryStyle match {
+    case MemoryStyle.Inferred =>
+      val mem = SyncReadMem(p.capacity, UInt(W.W))
+      when(io.write.valid) { mem.write(io.write.bits.index, io.write.bits.box.asUInt) }
+      read.bits.box := mem.read(rObj, readEvent)
+      Seq.iterate(read, p.memoryOutputStages + 1)(x => Pipe(x))
+    case MemoryStyle.Ecp5OutputRegister =>
+      val mem = Module(new RegisteredReadMemory(p.capacity, W))
+      mem.io.writeEnable := io.write.valid
+      mem.io.writeRow    := io.write.bits.index
+      mem.io.writeData   := io.write.bits.box.asUInt
+      mem.io.readEnable  := readEvent
+      mem.io.readRow     := rObj
+      read.bits.box := DontCare // only inside the memory
+      val first = Wire(Valid(new Entry))
+      first.valid    := RegNext(read.valid, false.B)
+      first.bits.tag := RegEnable(read.bits.tag, read.valid)
+      first.bits.box := mem.io.readData
+      read +: Seq.iterate(first, p.memoryOutputStages)(x => Pipe(x))
+  }
   readsInFlight := PopCount(readStages.map(_.valid))
   readQueue.io.enq.valid := readStages.last.valid
   readQueue.io.enq.bits  := readStages.last.bits
