@@ -72,7 +72,8 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
     AccelParams(m = 3, capacity = 24, batchCells = 8), // not a power of two
     AccelParams(m = 8, capacity = 64, batchCells = 16),
     AccelParams(m = 3, capacity = 25, arch = Arch.Stream, batchCells = 8),
-    AccelParams(m = 8, capacity = 64, arch = Arch.Stream, batchCells = 4)
+    AccelParams(m = 8, capacity = 64, arch = Arch.Stream, batchCells = 4),
+    AccelParams(m = 2, capacity = 10, arch = Arch.Stream, batchCells = 1) // the head register is the whole queue
   )
 
   behavior of "A batch"
