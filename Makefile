@@ -18,10 +18,13 @@ endif
 KEY_WIDTH ?= 32
 # How `make verilog` builds the coordinate memories (docs/fpga.md): inferred
 # (SyncReadMem) or ecp5-outreg (the first output register inside the DP16KD;
-# same cycles). `make fpga` uses FPGA_MEMORY_STYLE; reports of a style other
-# than the flow's default get it as suffix.
+# same cycles). `make fpga` uses FPGA_MEMORY_STYLE, by default ecp5-outreg for
+# the stream (measured better at m = 8) and inferred for the seed (ecp5-outreg
+# takes two DP16KD per memory there, and was slower: 73.9 against 106.1 MHz
+# at m = 8); reports of a style
+# other than the flow's default get it as suffix.
 MEMORY_STYLE ?= inferred
-FPGA_DEFAULT_MEMORY_STYLE := inferred
+FPGA_DEFAULT_MEMORY_STYLE := $(if $(filter stream,$(ARCH)),ecp5-outreg,inferred)
 FPGA_MEMORY_STYLE ?= $(FPGA_DEFAULT_MEMORY_STYLE)
 # Folders and reports of the seed architecture keep their names; others get the architecture as prefix.
 ARCH_PREFIX := $(if $(filter seed,$(ARCH)),,$(ARCH)-)
@@ -137,7 +140,7 @@ fpga: deps
 	$(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/$(FPGA_NAME) --m $(M) --out results/fpga/$(FPGA_NAME).json $(FPGA_ARGS)
 
 fpga-sweep: deps
-	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --verilog-root build/fpga-verilog --emit always --budget-min 60
+	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --memory-style $(FPGA_MEMORY_STYLE) --verilog-root build/fpga-verilog --emit always --budget-min 60
 
 $(FPGA_TEST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
 	$(SBT) "runMain bpaccel.EmitVerilog --m 2 --target-dir $(FPGA_TEST_VERILOG)"

@@ -1,6 +1,7 @@
 package bpaccel
 
 import chisel3._
+import chisel3.experimental.noPrefix
 import chisel3.util._
 
 /** The six coordinate buffers (min x, y, z, max x, y, z).
@@ -31,7 +32,8 @@ class CoordBuffer(p: AccelParams) extends Module {
   for (lane <- 0 until p.m) {
     val writeHere = io.write.valid && io.write.bits.lane === lane.U
     for ((wdata, c) <- coords(io.write.bits.box).zipWithIndex) {
-      coords(io.data(lane))(c) := (p.memoryStyle match {
+      // noPrefix: the memory keeps its plain name (module mem_<rows>x<width>), as before the styles.
+      coords(io.data(lane))(c) := noPrefix(p.memoryStyle match {
         case MemoryStyle.Inferred =>
           val mem = SyncReadMem(p.depth, UInt(p.keyWidth.W))
           when(writeHere) { mem.write(io.write.bits.row, wdata) }

@@ -17,8 +17,11 @@ import chisel3.util._
   * [[RegisteredReadMemorySpec]]); every simulation and proof runs this
   * Chisel description.
   *
-  * A row read in the cycle it is written is undefined on the DP16KD (its two
-  * ports collide), so that is asserted never to happen.
+  * A row read in the cycle it is written gives undefined data on the DP16KD
+  * (its two ports collide; the write itself succeeds). The seed does such
+  * reads while loading (every port reads row 0, only one lane's data is
+  * used), so they are allowed, but their data is poison here (the word
+  * inverted): a design that used it would fail its cycle-exact tests.
   */
 class RegisteredReadMemory(val rows: Int, val width: Int) extends Module {
   require(rows >= 1 && width >= 1, s"RegisteredReadMemory needs rows >= 1 and width >= 1, got $rows x $width")
@@ -37,12 +40,9 @@ class RegisteredReadMemory(val rows: Int, val width: Int) extends Module {
 
   private val mem = SyncReadMem(rows, UInt(width.W))
   when(io.writeEnable) { mem.write(io.writeRow, io.writeData) }
-  io.readData := RegEnable(mem.read(io.readRow, io.readEnable), RegNext(io.readEnable, false.B))
-
-  assert(
-    !(io.writeEnable && io.readEnable && io.writeRow === io.readRow),
-    "a row was read in the cycle it was written (undefined on the block RAM)"
-  )
+  private val read      = mem.read(io.readRow, io.readEnable)
+  private val collision = RegNext(io.writeEnable && io.readEnable && io.writeRow === io.readRow, false.B)
+  io.readData := RegEnable(Mux(collision, ~read, read), RegNext(io.readEnable, false.B))
 }
 
 object RegisteredReadMemory {

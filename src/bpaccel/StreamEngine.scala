@@ -40,6 +40,13 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   private def tagOf(index: UInt): UInt = if (p.debugPort) index else 0.U(0.W)
 
 
+  // ---- coordinate memory: one row of six keys per object (its read is below) ----
+  // Top-level vals, so the memory keeps its plain name (module mem_<rows>x<width>).
+  val mem = Option.when(p.memoryStyle == MemoryStyle.Inferred)(SyncReadMem(p.capacity, UInt(W.W)))
+  for (mem <- mem) when(io.write.valid) { mem.write(io.write.bits.index, io.write.bits.box.asUInt) }
+  val registeredMem =
+    Option.when(p.memoryStyle == MemoryStyle.Ecp5OutputRegister)(Module(new RegisteredReadMemory(p.capacity, W)))
+
   // ---- run state ----
   val n        = Reg(UInt(p.countWidth.W))
   val starting = RegInit(false.B)
@@ -92,19 +99,16 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       rHasNextBlock := rBlockLeft >= (2 * m).U
     } // past the last block the stream is never compared: hold
   }
-  // ---- coordinate memory: one row of six keys per object ----
+  // ---- the memory's read ----
   val read = Wire(Valid(new Entry))
   read.valid    := RegNext(readEvent, false.B)
   read.bits.tag := RegNext(tagOf(rObj))
   // The read, then memoryOutputStages registers; the first may sit in the block RAM.
-  val readStages = p.memoryStyle match {
-    case MemoryStyle.Inferred =>
-      val mem = SyncReadMem(p.capacity, UInt(W.W))
-      when(io.write.valid) { mem.write(io.write.bits.index, io.write.bits.box.asUInt) }
+  val readStages = (mem, registeredMem) match {
+    case (Some(mem), _) =>
       read.bits.box := mem.read(rObj, readEvent)
       Seq.iterate(read, p.memoryOutputStages + 1)(x => Pipe(x))
-    case MemoryStyle.Ecp5OutputRegister =>
-      val mem = Module(new RegisteredReadMemory(p.capacity, W))
+    case (_, Some(mem)) =>
       mem.io.writeEnable := io.write.valid
       mem.io.writeRow    := io.write.bits.index
       mem.io.writeData   := io.write.bits.box.asUInt
@@ -116,6 +120,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       first.bits.tag := RegEnable(read.bits.tag, read.valid)
       first.bits.box := mem.io.readData
       read +: Seq.iterate(first, p.memoryOutputStages)(x => Pipe(x))
+    case _ => throw new IllegalStateException("one of the two memories exists")
   }
   readsInFlight := PopCount(readStages.map(_.valid))
   readQueue.io.enq.valid := readStages.last.valid

@@ -104,6 +104,32 @@ class RegisteredReadMemorySpec extends AnyFlatSpec with ChiselScalatestTester wi
     }
   }
 
+  it should "give neither the old nor the new word for a row read in the cycle it is written (undefined on the DP16KD)" in {
+    test(new RegisteredReadMemory(8, 8)) { c =>
+      val (older, newer) = (0x0f, 0x3c)
+      def write(row: Int, data: Int): Unit = {
+        c.io.writeEnable.poke(true.B); c.io.writeRow.poke(row.U); c.io.writeData.poke(data.U)
+      }
+      c.io.readEnable.poke(false.B)
+      write(3, older)
+      c.clock.step()
+      write(3, newer)
+      c.io.readEnable.poke(true.B)
+      c.io.readRow.poke(3.U)
+      c.clock.step()
+      c.io.writeEnable.poke(false.B)
+      c.io.readEnable.poke(false.B)
+      c.clock.step()
+      c.io.readData.peek().litValue.toInt should (not equal older and not equal newer)
+      // Read again without a write: the word that was written.
+      c.io.readEnable.poke(true.B)
+      c.clock.step()
+      c.io.readEnable.poke(false.B)
+      c.clock.step()
+      c.io.readData.expect(newer.U)
+    }
+  }
+
   it should "differ when the block RAM's output register is off (REGMODE NOREG, one cycle early)" in {
     val (differ, compared) = mismatches(256, 32, "NOREG", cycles = 3000, seed = 7)
     compared should be > 1500

@@ -13,9 +13,10 @@
 // register loads one cycle after an enabled read". Yosys cannot infer OUTREG
 // (it only folds the address register into the block RAM), so
 // scripts/fpga/flow.py puts this module in place of the Chisel one. A row read
-// in the cycle it is written is undefined here (port collision); the Chisel
-// description asserts it never happens. RegisteredReadMemorySpec checks this
-// module against the Chisel one, cycle by cycle, on a DP16KD model.
+// in the cycle it is written gives undefined data here (port collision); the
+// Chisel description gives poison for it, so the design's tests show that no
+// such data is used. RegisteredReadMemorySpec checks this module against the
+// Chisel one, cycle by cycle, on a DP16KD model.
 module Ecp5RegisteredReadMemory #(
   parameter integer ROWS = 2048,
   parameter integer WIDTH = 32,
