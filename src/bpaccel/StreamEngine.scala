@@ -140,14 +140,20 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   // ---- the window: lane k holds object s+k ----
   val window = Reg(Vec(m, new Entry))
-  // Objects 0 .. m shift in as they are loaded; the flag says the next box is one of them.
+  // Objects 0 .. m shift in as they are loaded, one cycle after the load
+  // port took them: the load's valid and ready would otherwise reach the
+  // window's enables through the port logic (the m = 8 critical path once
+  // the load-ready was a register). The last box shifts in at the latest in
+  // the cycle of the launch, and the window is not used before the cycle
+  // after it. The flag says the next box is one of them.
+  val loadedBox  = Pipe(io.write)
   val takesLoads = RegInit(true.B)
-  when(io.write.valid) { takesLoads := io.write.bits.index < m.U }
+  when(loadedBox.valid) { takesLoads := loadedBox.bits.index < m.U }
   when(io.clear) { takesLoads := true.B } // a start: the next box is object 0
-  val loadShift = io.write.valid && takesLoads
+  val loadShift = loadedBox.valid && takesLoads
   val entry = Wire(new Entry)
-  entry.box := Mux(io.write.valid, io.write.bits.box.asUInt, readQueue.io.deq.bits.box)
-  entry.tag := Mux(io.write.valid, tagOf(io.write.bits.index), readQueue.io.deq.bits.tag)
+  entry.box := Mux(loadedBox.valid, loadedBox.bits.box.asUInt, readQueue.io.deq.bits.box)
+  entry.tag := Mux(loadedBox.valid, tagOf(loadedBox.bits.index), readQueue.io.deq.bits.tag)
   when(loadShift || fill || issue) {
     for (k <- 0 until m - 1) window(k) := window(k + 1)
     window(m - 1) := entry
@@ -156,9 +162,12 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // ---- A blocks ----
   val a     = Reg(Vec(m, new Entry))
   val aNext = Reg(Vec(m, new Entry))
-  // Block 0: object k (< m) is in the top lane the cycle after it was loaded.
-  val loadedTop      = RegNext(io.write.valid && io.write.bits.index < m.U, false.B)
-  val loadedTopIndex = RegNext(io.write.bits.index)
+  // Block 0: object k (< m) is in the top lane the cycle after it shifted in.
+  // The last box of a run may shift in at the launch, so its capture may come
+  // after the startup copied aNext into a: harmless, as object n-1 is never
+  // an A object that is compared (no object follows it).
+  val loadedTop      = RegNext(loadShift && loadedBox.bits.index < m.U, false.B)
+  val loadedTopIndex = RegNext(loadedBox.bits.index)
   // Later blocks: cycle k of a block finds object base+m+k in the top lane.
   val capture = Reg(UInt(m.W)) // one-hot: lane of aNext to fill at this issue
   for (k <- 0 until m) {
