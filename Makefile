@@ -18,13 +18,12 @@ endif
 KEY_WIDTH ?= 32
 # How `make verilog` builds the coordinate memories (docs/fpga.md): inferred
 # (SyncReadMem) or ecp5-outreg (the first output register inside the DP16KD;
-# same cycles). `make fpga` uses FPGA_MEMORY_STYLE, by default ecp5-outreg for
-# the stream (measured better at m = 8) and inferred for the seed (ecp5-outreg
-# takes two DP16KD per memory there, and was slower: 73.9 against 106.1 MHz
-# at m = 8); reports of a style
-# other than the flow's default get it as suffix.
+# same cycles). `make fpga` uses FPGA_MEMORY_STYLE, by default inferred: at
+# m = 8 ecp5-outreg was not measured faster (stream: +4 and -4 MHz at two
+# revisions; seed: 73.9 against 106.1 MHz, with two DP16KD per memory);
+# reports of a style other than the flow's default get it as suffix.
 MEMORY_STYLE ?= inferred
-FPGA_DEFAULT_MEMORY_STYLE := $(if $(filter stream,$(ARCH)),ecp5-outreg,inferred)
+FPGA_DEFAULT_MEMORY_STYLE := inferred
 FPGA_MEMORY_STYLE ?= $(FPGA_DEFAULT_MEMORY_STYLE)
 # Folders and reports of the seed architecture keep their names; others get the architecture as prefix.
 ARCH_PREFIX := $(if $(filter seed,$(ARCH)),,$(ARCH)-)
