@@ -16,9 +16,19 @@ else
 CAPACITY  ?= $(shell echo $$((256 * $(M))))
 endif
 KEY_WIDTH ?= 32
+# How `make verilog` builds the coordinate memories (docs/fpga.md): inferred
+# (SyncReadMem) or ecp5-outreg (the first output register inside the DP16KD;
+# same cycles). `make fpga` uses FPGA_MEMORY_STYLE, by default inferred: at
+# m = 8 ecp5-outreg was not measured faster (stream: +4 and -4 MHz at two
+# revisions; seed: 73.9 against 106.1 MHz, with two DP16KD per memory);
+# reports of a style other than the flow's default get it as suffix.
+MEMORY_STYLE ?= inferred
+FPGA_DEFAULT_MEMORY_STYLE := inferred
+FPGA_MEMORY_STYLE ?= $(FPGA_DEFAULT_MEMORY_STYLE)
 # Folders and reports of the seed architecture keep their names; others get the architecture as prefix.
 ARCH_PREFIX := $(if $(filter seed,$(ARCH)),,$(ARCH)-)
 VERILOG_DIR ?= generated/$(ARCH_PREFIX)m$(M)
+FPGA_NAME := $(ARCH_PREFIX)m$(M)$(if $(filter $(FPGA_DEFAULT_MEMORY_STYLE),$(FPGA_MEMORY_STYLE)),,-$(FPGA_MEMORY_STYLE))
 
 # The host is built for one configuration: ARCH, M and CAPACITY above.
 HOST_VERILOG := build/verilog/$(ARCH_PREFIX)m$(M)-c$(CAPACITY)
@@ -125,11 +135,11 @@ fuzz-long: fuzz
 # FPGA flow (docs/fpga.md): ECP5 synthesis, place and route with a measured
 # Fmax, and a Xilinx 7-series synthesis estimate.
 fpga: deps
-	$(MAKE) verilog ARCH=$(ARCH) M=$(M) CAPACITY=$(CAPACITY) KEY_WIDTH=$(KEY_WIDTH) VERILOG_DIR=build/fpga-verilog/$(ARCH_PREFIX)m$(M)
-	$(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/$(ARCH_PREFIX)m$(M) --m $(M) --out results/fpga/$(ARCH_PREFIX)m$(M).json $(FPGA_ARGS)
+	$(MAKE) verilog ARCH=$(ARCH) M=$(M) CAPACITY=$(CAPACITY) KEY_WIDTH=$(KEY_WIDTH) MEMORY_STYLE=$(FPGA_MEMORY_STYLE) VERILOG_DIR=build/fpga-verilog/$(FPGA_NAME)
+	$(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/$(FPGA_NAME) --m $(M) --out results/fpga/$(FPGA_NAME).json $(FPGA_ARGS)
 
 fpga-sweep: deps
-	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --verilog-root build/fpga-verilog --emit always --budget-min 60
+	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --memory-style $(FPGA_MEMORY_STYLE) --verilog-root build/fpga-verilog --emit always --budget-min 60
 
 $(FPGA_TEST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
 	$(SBT) "runMain bpaccel.EmitVerilog --m 2 --target-dir $(FPGA_TEST_VERILOG)"
@@ -141,7 +151,7 @@ test-fpga: deps $(FPGA_TEST_VERILOG)/filelist.f
 
 # SystemVerilog (one file per module, filelist.f) and bpaccel_params.h for one configuration.
 verilog: deps
-	$(SBT) "runMain bpaccel.EmitVerilog --arch $(ARCH) --m $(M) --capacity $(CAPACITY) --key-width $(KEY_WIDTH) --target-dir $(VERILOG_DIR)"
+	$(SBT) "runMain bpaccel.EmitVerilog --arch $(ARCH) --m $(M) --capacity $(CAPACITY) --key-width $(KEY_WIDTH) --memory-style $(MEMORY_STYLE) --target-dir $(VERILOG_DIR)"
 	cd $(VERILOG_DIR) && verilator --lint-only -Wall lint_waivers.vlt -F filelist.f --top-module BroadPhaseAccel
 	@echo "Verilog for arch=$(ARCH), m=$(M), capacity=$(CAPACITY): $(VERILOG_DIR)/filelist.f"
 

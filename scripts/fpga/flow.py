@@ -58,6 +58,13 @@ DEBIAN_YOSYS = "/usr/bin/yosys"
 
 EXIT_OK, EXIT_TOOL, EXIT_INPUT, EXIT_NOFIT, EXIT_TIMEOUT = 0, 1, 2, 3, 4
 
+# The generator's memories with a registered read (src/bpaccel/RegisteredReadMemory.scala,
+# memory style ecp5-outreg): the ECP5 run builds them from DP16KD with REGMODE OUTREG.
+REGISTERED_MEMORY_PREFIX = "RegisteredReadMemory_"
+REGISTERED_MEMORY_PORTS = ["clock", "reset", "io_writeEnable", "io_writeRow", "io_writeData",
+                           "io_readEnable", "io_readRow", "io_readData"]
+ECP5_REGISTERED_MEMORY = Path(__file__).resolve().parent / "ecp5" / "Ecp5RegisteredReadMemory.v"
+
 XILINX_LUTS = ["LUT1", "LUT2", "LUT3", "LUT4", "LUT5", "LUT6"]
 XILINX_FFS = ["FDRE", "FDSE", "FDCE", "FDPE", "LDCE", "LDPE"]
 XILINX_BRAMS = ["RAMB18E1", "RAMB36E1"]
@@ -180,6 +187,68 @@ def module_names(vdir: Path, files: list[str]) -> list[str]:
     for f in files:
         names += re.findall(r"^\s*module\s+(\w+)", (vdir / f).read_text(), re.M)
     return names
+
+
+def ecp5_dp16kd_tiles(rows: int, width: int) -> int:
+    """DP16KD that Ecp5RegisteredReadMemory.v uses for one memory (18-bit tiles up to 1024 rows, else 9)."""
+    tile = 18 if rows <= 1024 else 9
+    return -(-width // tile)
+
+
+def ecp5_registered_memories(work: Path, files: list[str]) -> tuple[list[str], list[dict]]:
+    """Puts the ECP5 implementation (DP16KD, REGMODE OUTREG) in place of each generated
+    RegisteredReadMemory_<rows>x<width> module, for the ECP5 runs only.
+
+    Returns the file list for ECP5 synthesis and [{module, rows, width, dp16kd}]. The module's
+    ports must be exactly the generator's (REGISTERED_MEMORY_PORTS, widths matching its name):
+    anything else is an error rather than a silently different memory."""
+    ecp5_files, mems = [], []
+    for f in files:
+        text = (work / f).read_text()
+        mm = re.search(rf"^\s*module\s+({REGISTERED_MEMORY_PREFIX}(\d+)x(\d+))\s*\((.*?)\);", text, re.M | re.S)
+        if not mm:
+            ecp5_files.append(f)
+            continue
+        name, rows, width = mm.group(1), int(mm.group(2)), int(mm.group(3))
+        widths: dict[str, int] = {}
+        bits = 1
+        for line in mm.group(4).splitlines():
+            pm = re.match(r"^\s*(?:input|output)?\s*(\[(\d+):0\])?\s*(\w+)\s*,?\s*$", line)
+            if not pm:
+                if line.strip():
+                    raise FlowError(EXIT_INPUT, f"{f}: unexpected port line '{line.strip()}' in {name}")
+                continue
+            if pm.group(1) or re.match(r"^\s*(input|output)", line):
+                bits = int(pm.group(2)) + 1 if pm.group(1) else 1
+            widths[pm.group(3)] = bits
+        row_bits = max(1, (rows - 1).bit_length())
+        expected = dict.fromkeys(REGISTERED_MEMORY_PORTS, 1)
+        expected.update(io_writeRow=row_bits, io_readRow=row_bits, io_writeData=width, io_readData=width)
+        if widths != expected:
+            raise FlowError(EXIT_INPUT, f"{f}: {name} has ports {widths}, expected {expected}")
+        if rows > 2048:
+            raise FlowError(EXIT_INPUT, f"{f}: {name}: more than 2048 rows need a DP16KD cascade (not built)")
+        ecp5_file = f"ecp5_{name}.v"
+        (work / ecp5_file).write_text(
+            f"// Written by scripts/fpga/flow.py: {name} of the generator built from DP16KD (REGMODE OUTREG).\n"
+            f"module {name}(\n"
+            f"  input clock, input reset, input io_writeEnable, input [{row_bits - 1}:0] io_writeRow,\n"
+            f"  input [{width - 1}:0] io_writeData, input io_readEnable, input [{row_bits - 1}:0] io_readRow,\n"
+            f"  output [{width - 1}:0] io_readData\n);\n"
+            f"  Ecp5RegisteredReadMemory #(.ROWS({rows}), .WIDTH({width}), .ROW_BITS({row_bits})) ram (\n"
+            f"    .clock(clock), .write_enable(io_writeEnable), .write_row(io_writeRow), .write_data(io_writeData),\n"
+            f"    .read_enable(io_readEnable), .read_row(io_readRow), .read_data(io_readData));\n"
+            f"endmodule\n")
+        ecp5_files.append(ecp5_file)
+        mems.append({"module": name, "rows": rows, "width": width, "dp16kd": ecp5_dp16kd_tiles(rows, width)})
+    if mems:
+        shutil.copy2(ECP5_REGISTERED_MEMORY, work / ECP5_REGISTERED_MEMORY.name)
+        ecp5_files.append(ECP5_REGISTERED_MEMORY.name)
+    return ecp5_files, mems
+
+
+def instance_count(work: Path, files: list[str], module: str) -> int:
+    return sum(len(re.findall(rf"^\s*{module}\s+\w+\s*\(", (work / f).read_text(), re.M)) for f in files)
 
 
 def top_ports(runner: Runner, yosys: Path, top_file: str) -> list[tuple[str, str, int]]:
@@ -383,6 +452,12 @@ def flow(args) -> int:
     mem_modules = [n for n in mods if n.startswith("mem_")]
     params = parse_params(vdir)
     capacity = params.get("capacity")
+    ecp5_files, registered = ecp5_registered_memories(work, files)
+    memory_style = "ecp5-outreg" if registered else "inferred"
+    if params.get("memory_style", memory_style) != memory_style:
+        raise FlowError(EXIT_INPUT, f"bpaccel_params.h says memory style {params['memory_style']}, "
+                                    f"but the Verilog has {'' if registered else 'no '}RegisteredReadMemory modules")
+    params["memory_style"] = memory_style
 
     t0 = time.monotonic()
     bins = ensure_venv(args.venv.resolve())
@@ -395,14 +470,15 @@ def flow(args) -> int:
         "yosys_ecp5": tool_version([yosys, "-V"], work),
         "nextpnr_ecp5": tool_version([nextpnr, "--version"], work),
     }
-    src_list = " ".join(files)
+    src_list = " ".join(files)  # as emitted: the Xilinx estimate infers every memory
+    ecp5_src_list = " ".join(ecp5_files)
 
     # ---- the wrapper
     wrapper_info = write_wrapper(runner, bins, files, work)
 
     # ---- ECP5 synthesis (the design that is placed and routed)
     (work / "ecp5.ys").write_text(
-        f"read_verilog -sv {src_list} fpga_wrapper.v\n"
+        f"read_verilog -sv {ecp5_src_list} fpga_wrapper.v\n"
         f"synth_ecp5 -top {WRAPPER_TOP} -json ecp5.json\n"
         f"tee -q -o ecp5_stat.json stat -json\n")
     code, ytext = runner.run("yosys synth_ecp5", [yosys, "-q", "-l", "ecp5.log", "-s", "ecp5.ys"], "ecp5.stdout")
@@ -422,18 +498,28 @@ def flow(args) -> int:
     arch = params.get("arch", "seed")
     n_mems = 1 if arch == "stream" else 6 * m
     dp16 = ecp5_cells.get("DP16KD", 0)
-    bram_mapped = sum(v for k, v in ecp5_memmap.items() if "16KD" in k)
-    mems_in_bram = bram_mapped == n_mems and dp16 >= n_mems and "FF" not in ecp5_memmap \
-        and not any("DPR16X4" in k for k in ecp5_memmap)
+    if registered:
+        # Instantiated, not inferred: every one of the n_mems memories is a RegisteredReadMemory.
+        instances = sum(instance_count(work, files, r["module"]) for r in registered)
+        tiles = sum(instance_count(work, files, r["module"]) * r["dp16kd"] for r in registered)
+        mems_in_bram = instances == n_mems and dp16 >= tiles
+    else:
+        bram_mapped = sum(v for k, v in ecp5_memmap.items() if "16KD" in k)
+        mems_in_bram = bram_mapped == n_mems and dp16 >= n_mems and "FF" not in ecp5_memmap \
+            and not any("DPR16X4" in k for k in ecp5_memmap)
     per_mem = dp16 / n_mems if n_mems else None
     memories = {
         "instances": n_mems,
-        "module": mem_modules,
+        "module": [r["module"] for r in registered] or mem_modules,
+        "style": memory_style,
         "ecp5_mapping": ecp5_memmap,
         "ecp5_mapping_all_memories": ecp5_memmap_all,
         "dp16kd_per_memory": per_mem,
         "memories_in_bram": mems_in_bram,
-        "note": (f"one memory of six keys a row, {dp16} DP16KD" if arch == "stream" and mems_in_bram else
+        "note": (f"memory style ecp5-outreg: each memory is {registered[0]['dp16kd']} DP16KD instantiated with "
+                 f"REGMODE_B OUTREG (scripts/fpga/ecp5/Ecp5RegisteredReadMemory.v), {dp16} DP16KD in all"
+                 if registered and mems_in_bram else
+                 f"one memory of six keys a row, {dp16} DP16KD" if arch == "stream" and mems_in_bram else
                  "each memory has one write and one read port; Yosys maps it to one "
                  "pseudo-dual-port DP16KD (512x36), using 256 of its 512 rows"
                  if mems_in_bram and per_mem == 1 else
@@ -470,8 +556,9 @@ def flow(args) -> int:
                 xil = xilinx(runner, args.debian_yosys, src_list, n_mems)
             breakdown = None
             if not args.no_breakdown:
-                breakdown = ecp5_breakdown(runner, yosys, src_list, mods, mem_modules,
-                                       core_synth_cells(ecp5_cells, wrapper_cells), m)
+                breakdown = ecp5_breakdown(runner, yosys, ecp5_src_list, mods,
+                                           mem_modules + [r["module"] for r in registered],
+                                           core_synth_cells(ecp5_cells, wrapper_cells), m)
             result.update({
                 "status": "does_not_fit",
                 "fits": False,
@@ -507,8 +594,9 @@ def flow(args) -> int:
 
     breakdown = None
     if not args.no_breakdown:
-        breakdown = ecp5_breakdown(runner, yosys, src_list, mods, mem_modules,
-                                       core_synth_cells(ecp5_cells, wrapper_cells), m)
+        breakdown = ecp5_breakdown(runner, yosys, ecp5_src_list, mods,
+                                   mem_modules + [r["module"] for r in registered],
+                                   core_synth_cells(ecp5_cells, wrapper_cells), m)
 
     lut_slots = util_used(rutil, "TRELLIS_COMB")
     ffs = util_used(rutil, "TRELLIS_FF")
@@ -608,7 +696,9 @@ def update_breakdown(args) -> int:
     write_wrapper(runner, bins, files, work)
     wrapper_cells = wrapper_only_cells(runner, yosys, work)
     synth = rep["ecp5"]["synth_cells"] if rep["status"] == "ok" else rep["ecp5_demand"]["synth_cells"]
-    rep["breakdown_ecp5_synth"] = ecp5_breakdown(runner, yosys, " ".join(files), mods, mem_modules,
+    ecp5_files, registered = ecp5_registered_memories(work, files)
+    rep["breakdown_ecp5_synth"] = ecp5_breakdown(runner, yosys, " ".join(ecp5_files), mods,
+                                                 mem_modules + [r["module"] for r in registered],
                                                  core_synth_cells(synth, wrapper_cells), m)
     rep.setdefault("runtime_s", {})["yosys breakdown"] = runner.runtimes.get("yosys breakdown")
     npr = work / "nextpnr_report.json"
@@ -651,6 +741,10 @@ def parse_params(vdir: Path) -> dict:
                 out[key] = int(mm.group(1))
         mm = re.search(r'^#define\s+BPACCEL_ARCH\s+"(\w+)"', text, re.M)
         out["arch"] = mm.group(1) if mm else "seed"  # headers from before the stream architecture
+        fp = re.search(r'^#define\s+BPACCEL_FINGERPRINT\s+"([^"]*)"', text, re.M)
+        if fp:  # the fingerprint names the memory style only when it is not the default
+            ms = re.search(r"(?:^|,)memory=([\w-]+)", fp.group(1))
+            out["memory_style"] = ms.group(1) if ms else "inferred"
     return out
 
 
@@ -660,6 +754,7 @@ def base_report(m, capacity, params, args, versions, wrapper_info) -> dict:
     return {
         "schema": "bpaccel-fpga-1",
         "arch": params.get("arch", "seed"),
+        "memory_style": params.get("memory_style", "inferred"),
         "m": m,
         "capacity": capacity,
         "key_width": params.get("key_width"),

@@ -61,6 +61,9 @@ def main() -> int:
     ap.add_argument("--emit", choices=["missing", "always", "never"], default="missing",
                     help="when to call `make verilog M=<m> VERILOG_DIR=<verilog-root>/m<m>` "
                          "(missing: only when filelist.f is absent)")
+    ap.add_argument("--memory-style", choices=["inferred", "ecp5-outreg"], default="inferred",
+                    help="coordinate memories of the emitted Verilog (make verilog MEMORY_STYLE=...; "
+                         "make fpga-sweep passes the flow's default for the architecture)")
     ap.add_argument("--clock-mhz", type=float, default=200.0)
     ap.add_argument("--venv", type=Path, default=REPO / ".venv")
     ap.add_argument("--flow-arg", action="append", default=[], help="extra argument passed to flow.py (repeatable)")
@@ -125,7 +128,7 @@ def main() -> int:
                 continue
             log(f"emitting Verilog for m={m} into {vdir}")
             r = subprocess.run(["make", "-C", str(REPO), "verilog", f"ARCH={args.arch}", f"M={m}",
-                                f"VERILOG_DIR={vdir.resolve()}",
+                                f"VERILOG_DIR={vdir.resolve()}", f"MEMORY_STYLE={args.memory_style}",
                                 *([f"CAPACITY={args.capacity}"] if args.capacity else [])])
             if r.returncode != 0:
                 entry.update({"status": "failed", "reason": f"make verilog M={m} failed (exit {r.returncode})"})
@@ -202,7 +205,7 @@ def fmt(x, nd=0):
 
 def render(sweep: dict) -> str:
     rows = []
-    head = ("| m | capacity | ECP5 LUT4 | ECP5 FF | DP16KD | **Fmax (MHz)** | pair tests/s = m × Fmax | "
+    head = ("| m | capacity | memories | ECP5 LUT4 | ECP5 FF | DP16KD | **Fmax (MHz)** | pair tests/s = m × Fmax | "
             "xc7 LUT | xc7 FF | xc7 RAMB18 | flow wall time |")
     rows.append(head)
     rows.append("|---:" * (head.count("|") - 1) + "|")
@@ -214,17 +217,19 @@ def render(sweep: dict) -> str:
         wall = f"{e['wall_s'] / 60:.1f} min" if e.get("wall_s") else "–"
         if st == "ok":
             ec, x = d["ecp5"], d.get("xilinx_estimate") or {}
-            rows.append(f"| {m} | {fmt(d['capacity'])} | {fmt(ec['luts'])} | {fmt(ec['ffs'])} | {ec['bram_dp16kd']} | "
+            rows.append(f"| {m} | {fmt(d['capacity'])} | {d.get('memory_style', 'inferred')} | {fmt(ec['luts'])} | "
+                        f"{fmt(ec['ffs'])} | {ec['bram_dp16kd']} | "
                         f"**{ec['fmax_mhz']:.1f}** | {m * ec['fmax_mhz'] / 1e3:.2f} G | {fmt(x.get('luts'))} | "
                         f"{fmt(x.get('ffs'))} | {fmt(x.get('bram_ramb18e1'))} | {wall} |")
         elif st == "does_not_fit":
             dem = d["ecp5_demand"]["over_capacity"]
             why = ", ".join(f"{k} {v['used']}/{v['available']}" for k, v in dem.items()) or "see report"
             x = d.get("xilinx_estimate") or {}
-            rows.append(f"| {m} | {fmt(d['capacity'])} | does not fit | | {why} | – | – | {fmt(x.get('luts'))} | "
+            rows.append(f"| {m} | {fmt(d['capacity'])} | {d.get('memory_style', 'inferred')} | does not fit | | {why} | – | – | "
+                        f"{fmt(x.get('luts'))} | "
                         f"{fmt(x.get('ffs'))} | {fmt(x.get('bram_ramb18e1'))} | {wall} |")
         else:
-            rows.append(f"| {m} | | {st.replace('_', ' ')} (below) | | | | | | | | |")
+            rows.append(f"| {m} | | | {st.replace('_', ' ')} (below) | | | | | | | | |")
             notes.append(f"* m = {m}: {e.get('reason', '')}")
     arch = sweep.get("arch", "seed")
     begin, end = markers(arch)

@@ -11,6 +11,7 @@ import unittest
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))  # flow.py's functions, for the tests that need no tools
 VERILOG_DIR: Path
 
 
@@ -65,6 +66,38 @@ class FlowOnSmallConfiguration(unittest.TestCase):
                                   "--out", str(Path(empty) / "r.json")], capture_output=True, text=True)
             self.assertNotEqual(run.returncode, 0)
             self.assertFalse((Path(empty) / "r.json").exists())
+
+
+class RegisteredMemorySubstitution(unittest.TestCase):
+    """The ECP5 run builds the generator's RegisteredReadMemory modules from DP16KD
+    (memory style ecp5-outreg), and only when their ports are the generator's."""
+    HEADER = ("module RegisteredReadMemory_300x20(\n  input         clock,\n                reset,\n"
+              "                io_writeEnable,\n  input  [8:0]  io_writeRow,\n  input  [19:0] io_writeData,\n"
+              "  input         io_readEnable,\n  input  [8:0]  io_readRow,\n  output [19:0] io_readData\n);\n"
+              "endmodule\n")
+
+    def substitute(self, header: str):
+        import flow
+        with tempfile.TemporaryDirectory() as d:
+            work = Path(d)
+            (work / "Other.sv").write_text("module Other(); endmodule\n")
+            (work / "RegisteredReadMemory_300x20.sv").write_text(header)
+            files, mems = flow.ecp5_registered_memories(work, ["Other.sv", "RegisteredReadMemory_300x20.sv"])
+            return files, mems, {f: (work / f).read_text() for f in files}
+
+    def test_replaces_the_module_by_dp16kd_with_the_output_register(self):
+        files, mems, texts = self.substitute(self.HEADER)
+        self.assertEqual(files, ["Other.sv", "ecp5_RegisteredReadMemory_300x20.v", "Ecp5RegisteredReadMemory.v"])
+        self.assertEqual(mems, [{"module": "RegisteredReadMemory_300x20", "rows": 300, "width": 20, "dp16kd": 2}])
+        self.assertIn(".ROWS(300), .WIDTH(20), .ROW_BITS(9)", texts["ecp5_RegisteredReadMemory_300x20.v"])
+        self.assertIn('parameter REGMODE = "OUTREG"', texts["Ecp5RegisteredReadMemory.v"])
+
+    def test_refuses_ports_that_are_not_the_generators(self):
+        import flow
+        for wrong in (self.HEADER.replace("[8:0]  io_readRow", "[9:0]  io_readRow"),
+                      self.HEADER.replace("io_readEnable", "io_readEn")):
+            with self.assertRaises(flow.FlowError):
+                self.substitute(wrong)
 
 
 if __name__ == "__main__":

@@ -22,6 +22,29 @@ object Arch {
     )
 }
 
+/** How the coordinate memories are built (see [[RegisteredReadMemory]]).
+  *
+  *  - [[MemoryStyle.Inferred]]: a `SyncReadMem`, every output register in the
+  *    fabric. Yosys folds the first register into the block RAM's synchronous
+  *    read, but cannot use the DP16KD's own output register (REGMODE OUTREG).
+  *  - [[MemoryStyle.Ecp5OutputRegister]]: each memory and the first of its
+  *    output registers form one module, [[RegisteredReadMemory]]; the FPGA flow
+  *    builds it from DP16KD with the output register on (scripts/fpga/ecp5). The
+  *    same registers, the same cycles: simulation and proofs do not change.
+  */
+sealed abstract class MemoryStyle(val name: String)
+object MemoryStyle {
+  case object Inferred           extends MemoryStyle("inferred")
+  case object Ecp5OutputRegister extends MemoryStyle("ecp5-outreg")
+  val all: Seq[MemoryStyle] = Seq(Inferred, Ecp5OutputRegister)
+  def fromName(name: String): MemoryStyle =
+    all.find(_.name == name).getOrElse(
+      throw new IllegalArgumentException(
+        s"memoryStyle must be one of ${all.map(_.name).mkString(", ")}, got memoryStyle = $name"
+      )
+    )
+}
+
 /** Every parameter of the generator, checked once here so that every module
   * can trust them.
   *
@@ -41,6 +64,8 @@ object Arch {
   * @param batchCells       cell counts the batch front end queues (see [[BatchControl]])
   * @param faults           deliberate bugs for the formal checks' mutant tests (see [[Fault]]);
   *                         empty for every real build
+  * @param memoryStyle      how the coordinate memories are built (see [[MemoryStyle]]);
+  *                         never changes a cycle
   */
 case class AccelParams(
   m: Int = 8,
@@ -52,7 +77,8 @@ case class AccelParams(
   arch: Arch = Arch.Seed,
   counterWidth: Int = 64,
   batchCells: Int = 64,
-  faults: Set[Fault] = Set.empty
+  faults: Set[Fault] = Set.empty,
+  memoryStyle: MemoryStyle = MemoryStyle.Inferred
 ) {
   require(m >= 1, s"parallelism m must be at least 1, got m = $m")
   require(capacity >= 2, s"capacity must be at least 2 objects, got capacity = $capacity")
@@ -64,6 +90,11 @@ case class AccelParams(
     memoryOutputStages >= 0 && memoryOutputStages <= 4,
     s"memoryOutputStages must lie in 0..4, got $memoryOutputStages"
   )
+  require(
+    memoryStyle != MemoryStyle.Ecp5OutputRegister || memoryOutputStages >= 1,
+    s"memoryStyle ${MemoryStyle.Ecp5OutputRegister.name} moves the first memory output register into the " +
+      s"block RAM, so it needs memoryOutputStages >= 1, got $memoryOutputStages"
+  )
   require(keyWidth >= 1 && keyWidth <= 64, s"keyWidth must lie in 1..64, got keyWidth = $keyWidth")
   require(counterWidth >= 1 && counterWidth <= 64, s"counterWidth must lie in 1..64, got counterWidth = $counterWidth")
   require(batchCells >= 1 && batchCells < (1 << 16), s"batchCells must lie in 1..65535, got batchCells = $batchCells")
@@ -74,6 +105,15 @@ case class AccelParams(
 
   /** Rows of each of the m striped memories of the seed architecture. */
   val depth: Int = (capacity / m).max(1)
+
+  /** Rows of each coordinate memory: the seed's striped ones, or the stream's single one. */
+  val memoryRows: Int = if (arch == Arch.Stream) capacity else depth
+
+  require(
+    memoryStyle != MemoryStyle.Ecp5OutputRegister || memoryRows <= RegisteredReadMemory.maxEcp5Rows,
+    s"memoryStyle ${MemoryStyle.Ecp5OutputRegister.name} builds each memory from DP16KD of at most " +
+      s"${RegisteredReadMemory.maxEcp5Rows} rows (no cascade), got $memoryRows rows"
+  )
 
   /** Bits of an object index 0 .. capacity-1. */
   val indexWidth: Int = log2Ceil(capacity).max(1)

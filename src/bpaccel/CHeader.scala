@@ -7,7 +7,9 @@ object CHeader {
   /** One string that names the whole configuration; the host compares it. */
   def fingerprint(p: AccelParams): String =
     s"arch=${p.arch.name},m=${p.m},capacity=${p.capacity},key_width=${p.keyWidth},queue=${p.resultQueueDepth}," +
-      s"memstages=${p.memoryOutputStages},debug=${if (p.debugPort) 1 else 0},batch=${p.batchCells}"
+      s"memstages=${p.memoryOutputStages},debug=${if (p.debugPort) 1 else 0},batch=${p.batchCells}" +
+      // Named only when not the default, so every earlier fingerprint stays valid.
+      (if (p.memoryStyle != MemoryStyle.Inferred) s",memory=${p.memoryStyle.name}" else "")
 
   /** The parameters in AccelParams' own notation, leaving out the fields only
     * the formal checks change while they hold their defaults.
@@ -15,7 +17,8 @@ object CHeader {
   private def describe(p: AccelParams): String = {
     val fields = Seq(p.m, p.capacity, p.keyWidth, p.resultQueueDepth, p.memoryOutputStages, p.debugPort, p.arch) ++
       (if (p.counterWidth != AccelParams().counterWidth) Seq(s"counterWidth=${p.counterWidth}") else Nil) ++
-      Seq(s"batchCells=${p.batchCells}") ++ (if (p.faults.nonEmpty) Seq(s"faults=${p.faults}") else Nil)
+      Seq(s"batchCells=${p.batchCells}") ++ (if (p.faults.nonEmpty) Seq(s"faults=${p.faults}") else Nil) ++
+      (if (p.memoryStyle != MemoryStyle.Inferred) Seq(s"memoryStyle=${p.memoryStyle}") else Nil)
     fields.mkString("AccelParams(", ",", ")")
   }
 

@@ -1,6 +1,7 @@
 package bpaccel
 
 import chisel3._
+import chisel3.experimental.noPrefix
 import chisel3.util._
 
 /** The six coordinate buffers (min x, y, z, max x, y, z).
@@ -10,7 +11,8 @@ import chisel3.util._
   * Each memory has one write port (loading) and one read port (the B window;
   * the A blocks are captured from it, see [[SeedEngine]]): the shape of a
   * simple dual-port block RAM, one DP16KD on ECP5. Reads take one cycle
-  * (synchronous, as block RAM).
+  * (synchronous, as block RAM), or two with [[MemoryStyle.Ecp5OutputRegister]],
+  * whose memories include the first output register ([[readLatency]]).
   */
 class CoordBuffer(p: AccelParams) extends Module {
   val io = IO(new Bundle {
@@ -21,7 +23,7 @@ class CoordBuffer(p: AccelParams) extends Module {
     }))
     val readEnable = Input(Bool())
     val rows       = Input(Vec(p.m, UInt(p.rowWidth.W)))
-    /** Memory k's read data, one cycle after the read. */
+    /** Memory k's read data, readLatency cycles after the read. */
     val data = Output(Vec(p.m, new Aabb(p.keyWidth)))
   })
 
@@ -30,9 +32,29 @@ class CoordBuffer(p: AccelParams) extends Module {
   for (lane <- 0 until p.m) {
     val writeHere = io.write.valid && io.write.bits.lane === lane.U
     for ((wdata, c) <- coords(io.write.bits.box).zipWithIndex) {
-      val mem = SyncReadMem(p.depth, UInt(p.keyWidth.W))
-      when(writeHere) { mem.write(io.write.bits.row, wdata) }
-      coords(io.data(lane))(c) := mem.read(io.rows(lane), io.readEnable)
+      // noPrefix: the memory keeps its plain name (module mem_<rows>x<width>), as before the styles.
+      coords(io.data(lane))(c) := noPrefix(p.memoryStyle match {
+        case MemoryStyle.Inferred =>
+          val mem = SyncReadMem(p.depth, UInt(p.keyWidth.W))
+          when(writeHere) { mem.write(io.write.bits.row, wdata) }
+          mem.read(io.rows(lane), io.readEnable)
+        case MemoryStyle.Ecp5OutputRegister =>
+          val mem = Module(new RegisteredReadMemory(p.depth, p.keyWidth))
+          mem.io.writeEnable := writeHere
+          mem.io.writeRow    := io.write.bits.row
+          mem.io.writeData   := wdata
+          mem.io.readEnable  := io.readEnable
+          mem.io.readRow     := io.rows(lane)
+          mem.io.readData
+      })
     }
+  }
+}
+
+object CoordBuffer {
+  /** Cycles from a read's rows to [[CoordBuffer]]'s data. */
+  def readLatency(p: AccelParams): Int = p.memoryStyle match {
+    case MemoryStyle.Inferred           => 1
+    case MemoryStyle.Ecp5OutputRegister => RegisteredReadMemory.readLatency
   }
 }

@@ -20,6 +20,7 @@ object EmitVerilog {
     debugPort: Boolean = false,
     arch: String = AccelParams().arch.name,
     batchCells: Int = AccelParams().batchCells,
+    memoryStyle: String = AccelParams().memoryStyle.name,
     targetDir: Path = Paths.get("generated")
   ) {
     def params: AccelParams =
@@ -31,7 +32,8 @@ object EmitVerilog {
         memoryOutputStages,
         debugPort,
         Arch.fromName(arch),
-        batchCells = batchCells
+        batchCells = batchCells,
+        memoryStyle = MemoryStyle.fromName(memoryStyle)
       )
   }
 
@@ -87,6 +89,12 @@ object EmitVerilog {
       opt[Int]("batch-cells")
         .action((v, o) => o.copy(batchCells = v))
         .text(s"cell counts the batch queue holds (default ${AccelParams().batchCells})")
+      opt[String]("memory-style")
+        .action((v, o) => o.copy(memoryStyle = v))
+        .text(
+          s"coordinate memories: ${MemoryStyle.all.map(_.name).mkString(" or ")} " +
+            s"(default ${AccelParams().memoryStyle.name}; see docs/fpga.md)"
+        )
       opt[String]("target-dir").action((v, o) => o.copy(targetDir = Paths.get(v))).text("output folder")
     }
     // Parameters are validated when the case class is built; report that as a usage error.

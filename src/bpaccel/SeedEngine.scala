@@ -86,12 +86,15 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   capture.lanes := Mux(issue.valid, issue.bits.capture, loadRead)
   capture.tags  := tags(portObjects)
 
-  // Memory read (1 cycle), then the memory output registers.
+  // Memory read (1 cycle), then the memory output registers; the buffer's
+  // data comes CoordBuffer.readLatency cycles after the read (the first
+  // output register may sit inside the memories).
   val memoryStages = Seq.iterate(
-    (buffer.io.data, Pipe(issue.valid, meta), Pipe(issue.valid || loadRead.orR, capture)),
+    (Pipe(issue.valid, meta), Pipe(issue.valid || loadRead.orR, capture)),
     p.memoryOutputStages + 1
-  ) { case (data, at, cap) => (RegNext(data), Pipe(at), Pipe(cap)) }
-  val (memData, atBuffered, captureAt) = memoryStages.last
+  ) { case (at, cap) => (Pipe(at), Pipe(cap)) }
+  val memData = Seq.iterate(buffer.io.data, p.memoryOutputStages + 2 - CoordBuffer.readLatency(p))(RegNext(_)).last
+  val (atBuffered, captureAt) = memoryStages.last
 
   // The A blocks, captured from the read data.
   val aNext     = Reg(Vec(m, new Aabb(p.keyWidth)))
@@ -117,7 +120,7 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   val atCompare = Pipe(atRotated)
   val probeI    = RegNext(aBlockTag)
 
-  val stages = memoryStages.map(_._2) ++ Seq(atRotated, atCompare)
+  val stages = memoryStages.map(_._1) ++ Seq(atRotated, atCompare)
   require(stages.length == p.pipelineLatency)
 
   io.activity.active   := sequencer.io.active

@@ -39,9 +39,13 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   }
   private def tagOf(index: UInt): UInt = if (p.debugPort) index else 0.U(0.W)
 
-  // ---- coordinate memory: one row of six keys per object ----
-  val mem = SyncReadMem(p.capacity, UInt(W.W))
-  when(io.write.valid) { mem.write(io.write.bits.index, io.write.bits.box.asUInt) }
+
+  // ---- coordinate memory: one row of six keys per object (its read is below) ----
+  // Top-level vals, so the memory keeps its plain name (module mem_<rows>x<width>).
+  val mem = Option.when(p.memoryStyle == MemoryStyle.Inferred)(SyncReadMem(p.capacity, UInt(W.W)))
+  for (mem <- mem) when(io.write.valid) { mem.write(io.write.bits.index, io.write.bits.box.asUInt) }
+  val registeredMem =
+    Option.when(p.memoryStyle == MemoryStyle.Ecp5OutputRegister)(Module(new RegisteredReadMemory(p.capacity, W)))
 
   // ---- run state ----
   val n        = Reg(UInt(p.countWidth.W))
@@ -95,11 +99,29 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       rHasNextBlock := rBlockLeft >= (2 * m).U
     } // past the last block the stream is never compared: hold
   }
+  // ---- the memory's read ----
   val read = Wire(Valid(new Entry))
   read.valid    := RegNext(readEvent, false.B)
-  read.bits.box := mem.read(rObj, readEvent)
   read.bits.tag := RegNext(tagOf(rObj))
-  val readStages = Seq.iterate(read, p.memoryOutputStages + 1)(x => Pipe(x))
+  // The read, then memoryOutputStages registers; the first may sit in the block RAM.
+  val readStages = (mem, registeredMem) match {
+    case (Some(mem), _) =>
+      read.bits.box := mem.read(rObj, readEvent)
+      Seq.iterate(read, p.memoryOutputStages + 1)(x => Pipe(x))
+    case (_, Some(mem)) =>
+      mem.io.writeEnable := io.write.valid
+      mem.io.writeRow    := io.write.bits.index
+      mem.io.writeData   := io.write.bits.box.asUInt
+      mem.io.readEnable  := readEvent
+      mem.io.readRow     := rObj
+      read.bits.box := DontCare // only inside the memory
+      val first = Wire(Valid(new Entry))
+      first.valid    := RegNext(read.valid, false.B)
+      first.bits.tag := RegEnable(read.bits.tag, read.valid)
+      first.bits.box := mem.io.readData
+      read +: Seq.iterate(first, p.memoryOutputStages)(x => Pipe(x))
+    case _ => throw new IllegalStateException("one of the two memories exists")
+  }
   readsInFlight := PopCount(readStages.map(_.valid))
   readQueue.io.enq.valid := readStages.last.valid
   readQueue.io.enq.bits  := readStages.last.bits

@@ -29,6 +29,16 @@ class AccelParamsSpec extends AnyFlatSpec with Matchers {
     rejection(AccelParams(memoryOutputStages = 5)) should include("memoryOutputStages")
   }
 
+  it should "reject the ecp5-outreg memory style without an output register to move, or deeper than one DP16KD column" in {
+    val outreg = MemoryStyle.Ecp5OutputRegister
+    rejection(AccelParams(memoryOutputStages = 0, memoryStyle = outreg)) should include("memoryOutputStages >= 1")
+    rejection(AccelParams(m = 1, capacity = 4096, memoryStyle = outreg)) should include("4096 rows")
+    rejection(AccelParams(m = 2, capacity = 4096, arch = Arch.Stream, memoryStyle = outreg)) should include("4096 rows")
+    AccelParams(m = 2, capacity = 4096, memoryStyle = outreg).memoryRows shouldBe 2048 // seed: rows per lane
+    MemoryStyle.fromName("ecp5-outreg") shouldBe outreg
+    intercept[IllegalArgumentException](MemoryStyle.fromName("outreg")).getMessage should include("inferred, ecp5-outreg")
+  }
+
   it should "reject a batch queue of no cells, and size the cell tag for the queue" in {
     rejection(AccelParams(batchCells = 0)) should include("batchCells")
     AccelParams(batchCells = 64).cellTagWidth shouldBe 6 // tags 0..63

@@ -73,13 +73,20 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
     AccelParams(m = 8, capacity = 64, batchCells = 16),
     AccelParams(m = 3, capacity = 25, arch = Arch.Stream, batchCells = 8),
     AccelParams(m = 8, capacity = 64, arch = Arch.Stream, batchCells = 4),
-    AccelParams(m = 2, capacity = 10, arch = Arch.Stream, batchCells = 1) // the head register is the whole queue
+    AccelParams(m = 2, capacity = 10, arch = Arch.Stream, batchCells = 1), // the head register is the whole queue
+    // Loads and runs overlap in a batch: the block RAM's read and write ports must never collide.
+    AccelParams(m = 3, capacity = 24, batchCells = 8, memoryStyle = MemoryStyle.Ecp5OutputRegister),
+    AccelParams(m = 3, capacity = 25, arch = Arch.Stream, batchCells = 8, memoryStyle = MemoryStyle.Ecp5OutputRegister)
   )
+
+  /** The configuration's name in a test's title. */
+  private def named(p: AccelParams): String =
+    s"m=${p.m}, ${p.arch.name}" + (if (p.memoryStyle != MemoryStyle.Inferred) s", memories ${p.memoryStyle.name}" else "")
 
   behavior of "A batch"
 
   for (p <- configurations)
-    it should s"give each cell exactly its golden pairs, tagged with it, under back-pressure (m=${p.m}, ${p.arch.name})" in {
+    it should s"give each cell exactly its golden pairs, tagged with it, under back-pressure (${named(p)})" in {
       withDriver(p) { (dut, drv) =>
         val rng       = new Random(7 * p.m + p.arch.id)
         var sawStalls = false

@@ -12,8 +12,14 @@ import scala.util.Random
   */
 class ScheduleHardwareSpec extends AnyFlatSpec with Simulators with Checks {
 
-  private def scheduleAllCounts(m: Int, counts: Int => Seq[Int], capacity: Int, arch: Arch = Arch.Seed): Unit = {
-    val p = AccelParams(m = m, capacity = capacity, debugPort = true, arch = arch)
+  private def scheduleAllCounts(
+    m: Int,
+    counts: Int => Seq[Int],
+    capacity: Int,
+    arch: Arch = Arch.Seed,
+    memoryStyle: MemoryStyle = MemoryStyle.Inferred
+  ): Unit = {
+    val p = AccelParams(m = m, capacity = capacity, debugPort = true, arch = arch, memoryStyle = memoryStyle)
     onVerilator(p) { dut =>
       val drv = new AccelDriver(dut)
       drv.idleInputs()
@@ -59,5 +65,14 @@ class ScheduleHardwareSpec extends AnyFlatSpec with Simulators with Checks {
         capacity = 3 * m,
         arch = Arch.Stream
       )
+    }
+
+  behavior of "The schedule with the output register inside the block RAM (memory style ecp5-outreg)"
+
+  // The same golden models and cycle formulas: the style moves a register, it adds none.
+  for ((arch, m) <- Seq(Arch.Seed -> 1, Arch.Seed -> 3, Arch.Seed -> 8, Arch.Stream -> 1, Arch.Stream -> 3, Arch.Stream -> 8))
+    it should s"match the ${arch.name} golden model for m=$m and every n up to the capacity" in {
+      val capacity = if (arch == Arch.Seed) 5 * m else 5 * m + 1
+      scheduleAllCounts(m, capacity => 0 to capacity, capacity, arch, MemoryStyle.Ecp5OutputRegister)
     }
 }
