@@ -70,7 +70,8 @@ class ScheduleHardwareSpec extends AnyFlatSpec with Simulators with Checks {
   behavior of "The schedule with the output register inside the block RAM (memory style ecp5-outreg)"
 
   // The same golden models and cycle formulas: the style moves a register, it adds none.
-  for ((arch, m) <- Seq(Arch.Seed -> 1, Arch.Seed -> 3, Arch.Seed -> 8, Arch.Stream -> 1, Arch.Stream -> 3, Arch.Stream -> 8))
+  // m = 3 (not a power of two) for both, and stream m = 8 as FPGA-built; kept to three for make test's time.
+  for ((arch, m) <- Seq(Arch.Seed -> 3, Arch.Stream -> 3, Arch.Stream -> 8))
     it should s"match the ${arch.name} golden model for m=$m and every n up to the capacity" in {
       val capacity = if (arch == Arch.Seed) 5 * m else 5 * m + 1
       scheduleAllCounts(m, capacity => 0 to capacity, capacity, arch, MemoryStyle.Ecp5OutputRegister)
