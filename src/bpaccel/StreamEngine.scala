@@ -39,7 +39,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   }
   private def tagOf(index: UInt): UInt = if (p.debugPort) index else 0.U(0.W)
 
-
   // ---- coordinate memory: one row of six keys per object (its read is below) ----
   // Top-level vals, so the memory keeps its plain name (module mem_<rows>x<width>).
   val mem = Option.when(p.memoryStyle == MemoryStyle.Inferred)(SyncReadMem(p.capacity, UInt(W.W)))
