@@ -31,6 +31,8 @@ lazy val root = (project in file("."))
     concurrentRestrictions in Global += Tags.limit(Tags.Test, 2),
     Test / fork := true,
     Test / javaOptions ++= Seq("-Xmx6g", "-Xss16m"),
+    // The formal checks' z3 (scripts/deps.sh installs it there) before any other.
+    Test / envVars += "PATH" -> s"${(baseDirectory.value / "build" / "formal-tools" / "bin").getAbsolutePath}:${sys.env.getOrElse("PATH", "")}",
     // The deep formal checks (tag bpaccel.FormalLong) run only with BPACCEL_FORMAL_LONG set: make formal-long.
     Test / testOptions ++= (
       if (sys.env.contains("BPACCEL_FORMAL_LONG")) Nil

@@ -150,10 +150,12 @@ case class AccelParams(
     */
   val runOverheadCycles: Int = pipelineLatency + 1
 
-  /** Cycles between the start and the first issue of a run of n >= 2 objects.
-    * Stream: the window must hold objects 1..m (the load shifted in objects
-    * 1..min(n-1, m), so m+1-n more shifts when n <= m) while the first
-    * readLatency reads travel to the window's entry; both at once.
+  /** Cycles between the start and the first issue of a run of n >= 2 objects,
+    * exactly n of them loaded (as the host does; with more loaded the stream's
+    * startup can only be shorter). Stream: the window must hold objects 1..m
+    * (the load shifted in objects 1..min(n-1, m), so m+1-n more shifts when
+    * n <= m) while the first readLatency reads travel to the window's entry;
+    * both at once.
     */
   def startupCycles(n: Long): Long = arch match {
     case Arch.Seed                => 0

@@ -27,6 +27,9 @@ object Fault {
   case object SkipSecondBlockAtMPlus2 extends Fault("a run of m+2 objects skips its second block")
   /** The comparators test min < max instead of min <= max: touching boxes are missed. */
   case object StrictCompare extends Fault("comparators miss touching boxes")
+  /** The stream's startup owes the window m+1-n shifts, as a first version did, although more boxes were
+    * loaded: for n <= m lane 0 then holds object n, not object 1 (a real bug, found by the whole-run proof). */
+  case object WindowFillFromCount extends Fault("the stream's startup fill counts from n, not from the boxes loaded")
   /** The batch front end does not count cells of fewer than two objects: later cells get the wrong tag. */
   case object CellCounterSkipsShortCells extends Fault("the batch's cell counter skips cells of 0 or 1 objects")
 
@@ -40,6 +43,7 @@ object Fault {
     RepeatLastBeat,
     SkipSecondBlockAtMPlus2,
     StrictCompare,
+    WindowFillFromCount,
     CellCounterSkipsShortCells
   )
 }

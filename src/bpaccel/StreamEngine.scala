@@ -25,8 +25,11 @@ import chisel3.util._
   * only). The window's entry chooses between the load port and the memory.
   *
   * Startup after the start: the first readLatency reads travel to the entry
-  * and, when n <= m, the window shifts m+1-n more times so object 1 reaches
-  * lane 0; both at once. Pipeline: comparator register, AND register.
+  * and, when fewer than m+1 boxes were loaded, the window shifts m+1-loaded
+  * more times so object 1 reaches lane 0; both at once. (Counted from the
+  * loads, not from n: a start may use fewer boxes than were loaded, and the
+  * window then already holds objects 1 .. m.) Pipeline: comparator
+  * register, AND register.
   */
 class StreamEngine(p: AccelParams) extends Engine(p) {
   private val m = p.m
@@ -150,6 +153,10 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   when(loadedBox.valid) { takesLoads := loadedBox.bits.index < m.U }
   when(io.clear) { takesLoads := true.B } // a start: the next box is object 0
   val loadShift = loadedBox.valid && takesLoads
+  // Shifts the startup still owes the window: m+1 minus the boxes shifted in.
+  val fillOwed = RegInit((m + 1).U(log2Ceil(m + 2).W))
+  when(loadShift) { fillOwed := fillOwed - 1.U } // at most m+1 boxes shift in
+  when(io.clear) { fillOwed := (m + 1).U }
   val entry = Wire(new Entry)
   entry.box := Mux(loadedBox.valid, loadedBox.bits.box.asUInt, readQueue.io.deq.bits.box)
   entry.tag := Mux(loadedBox.valid, tagOf(loadedBox.bits.index), readQueue.io.deq.bits.tag)
@@ -216,8 +223,14 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     n         := count
     starting  := true.B
     primeLeft := p.readLatency.U
-    fillLeft  := Mux(count <= m.U, (m + 1).U - count, 0.U)
-    filling   := count <= m.U
+    // The last box may shift in during this cycle.
+    if (p.has(Fault.WindowFillFromCount)) {
+      fillLeft := Mux(count <= m.U, (m + 1).U - count, 0.U)
+      filling  := count <= m.U
+    } else {
+      fillLeft := fillOwed - loadShift.asUInt
+      filling  := fillOwed > loadShift.asUInt
+    }
     base      := 0.U
     s         := 1.U
     left      := count - 2.U

@@ -72,6 +72,26 @@ class ProtocolSpec extends AnyFlatSpec with Simulators with Checks {
       }
     }
 
+    // The host always loads exactly n, but the protocol allows fewer: the
+    // boxes after the first n must play no part. (Found by the whole-run
+    // formal check at m = 2: the stream's window, filled from the loads,
+    // held object n in lane 0 when n <= m.)
+    "A start with n below the boxes loaded" should s"report exactly the pairs of the first n objects $arch" in {
+      withDut { (_, drv) =>
+        for (n <- 2 to p.m + 2; extra <- 1 to 3) withClue(s"n=$n, ${n + extra} loaded: ") {
+          val b = boxes(n + extra, 100 * n + extra)
+          drv.load(b)
+          val out = drv.start(n)
+          out.error shouldBe AccelError.code(AccelError.None)
+          out.pairs.distinct.length shouldBe out.pairs.length
+          out.pairs.toSet shouldBe Box.bruteForcePairs(b.take(n))
+          out.hits shouldBe out.pairs.length.toLong
+          out.issueCycles shouldBe Schedule.issueCycles(n, p.m)
+          out.cycles shouldBe out.driverCycles
+        }
+      }
+    }
+
     "Runs with fewer than two objects" should s"finish at once with no pairs and no error $arch" in {
       withDut { (_, drv) =>
         for (n <- Seq(0, 1)) {
