@@ -147,16 +147,17 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // window's enables through the port logic (the m = 8 critical path once
   // the load-ready was a register). The last box shifts in at the latest in
   // the cycle of the launch, and the window is not used before the cycle
-  // after it. The flag says the next box is one of them.
+  // after it. `fillOwed` counts the shifts the startup still owes the window:
+  // m+1 minus the boxes shifted in since the last start (a start: the next
+  // box is object 0). `takesLoads` is its `=/= 0`, kept as a register because
+  // it gates the window's enables.
   val loadedBox  = Pipe(io.write)
+  val fillOwed   = RegInit((m + 1).U(log2Ceil(m + 2).W))
   val takesLoads = RegInit(true.B)
-  when(loadedBox.valid) { takesLoads := loadedBox.bits.index < m.U }
-  when(io.clear) { takesLoads := true.B } // a start: the next box is object 0
-  val loadShift = loadedBox.valid && takesLoads
-  // Shifts the startup still owes the window: m+1 minus the boxes shifted in.
-  val fillOwed = RegInit((m + 1).U(log2Ceil(m + 2).W))
-  when(loadShift) { fillOwed := fillOwed - 1.U } // at most m+1 boxes shift in
-  when(io.clear) { fillOwed := (m + 1).U }
+  val loadShift  = loadedBox.valid && takesLoads
+  val fillOwedNext = Mux(io.clear, (m + 1).U, fillOwed - loadShift.asUInt) // at most m+1 boxes shift in
+  fillOwed   := fillOwedNext
+  takesLoads := fillOwedNext =/= 0.U
   val entry = Wire(new Entry)
   entry.box := Mux(loadedBox.valid, loadedBox.bits.box.asUInt, readQueue.io.deq.bits.box)
   entry.tag := Mux(loadedBox.valid, tagOf(loadedBox.bits.index), readQueue.io.deq.bits.tag)
