@@ -33,6 +33,19 @@ lazy val root = (project in file("."))
     Test / javaOptions ++= Seq("-Xmx6g", "-Xss16m"),
     // The formal checks' z3 (scripts/deps.sh installs it there) before any other.
     Test / envVars += "PATH" -> s"${(baseDirectory.value / "build" / "formal-tools" / "bin").getAbsolutePath}:${sys.env.getOrElse("PATH", "")}",
+    // Each Verilator-backed configuration compiles Verilator's runtime (about
+    // 13 of its 17 s); ccache compiles it once per machine (scripts/deps.sh
+    // installs it), and identical designs in different suites once too.
+    Test / envVars ++= (
+      if (new File("/usr/bin/ccache").exists)
+        Map(
+          "OBJCACHE"       -> "ccache",
+          "CCACHE_DIR"     -> (baseDirectory.value / "build" / "ccache").getAbsolutePath,
+          // Paths relative to here, so each configuration's directory hits the same entries.
+          "CCACHE_BASEDIR" -> baseDirectory.value.getAbsolutePath
+        )
+      else Map.empty[String, String]
+    ),
     // The deep formal checks (tag bpaccel.FormalLong) run only with BPACCEL_FORMAL_LONG set: make formal-long.
     Test / testOptions ++= (
       if (sys.env.contains("BPACCEL_FORMAL_LONG")) Nil

@@ -11,6 +11,7 @@ debian_packages=(
   libfcl-dev libcgal-dev libode-dev      # the benchmark's peer broad phases
   libtbb-dev                             # the host's thread pool
   clang libclang-rt-14-dev               # libFuzzer and the sanitizers
+  ccache                                 # the specs' Verilator builds share its runtime objects
 )
 
 missing=()
