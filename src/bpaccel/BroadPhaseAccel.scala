@@ -80,14 +80,13 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
 
   engine.io.write   := loader.io.write
   engine.io.clear   := clear
+  engine.io.prepare.valid := start.fire
+  engine.io.prepare.bits  := start.bits
   engine.io.launch  := control.io.launch
-  // Credits, registered so that no adder sits before the engine's enables:
-  // queue count + cycles in flight grows by at most one a cycle, so room for
-  // one more last cycle means room now.
-  engine.io.advance := RegNext(
-    queue.io.count +& engine.io.activity.inFlight +& 1.U < creditedEntries.U,
-    false.B
-  )
+  // Credits, registered in the engine so that no adder sits before its
+  // enables: queue count + cycles in flight grows by at most one a cycle, so
+  // room for one more now means room in the next cycle.
+  engine.io.room := queue.io.count +& engine.io.activity.inFlight +& 1.U < creditedEntries.U
   control.io.engine := engine.io.activity
 
   val beat = engine.io.out

@@ -95,8 +95,9 @@ class AccelInfo extends Bundle {
 class EngineIO(p: AccelParams) extends Bundle {
   val write    = Flipped(Valid(new LoadWrite(p)))
   val clear    = Input(Bool())                        // a start was accepted: the next box is object 0
+  val prepare  = Flipped(Valid(UInt(p.countWidth.W))) // a start was accepted (launched or not), with its n
   val launch   = Flipped(Valid(UInt(p.countWidth.W))) // a run of n >= 2 objects, all loaded
-  val advance  = Input(Bool())                        // the result queue has room for one more issue
+  val room     = Input(Bool())                        // the result queue has room for one more issue next cycle
   val activity = Output(new EngineActivity(p))
   val out      = Valid(new ScheduleBeat(p))           // one per issued cycle, mask = hits
   val probe    = if (p.debugPort) Some(Output(new DebugProbe(p))) else None
@@ -105,6 +106,11 @@ class EngineIO(p: AccelParams) extends Bundle {
 /** An architecture's datapath: memories, schedule and comparators. */
 abstract class Engine(val p: AccelParams) extends Module {
   val io = IO(new EngineIO(p))
+
+  /** Room for one more issue this cycle. The engine registers it itself so that
+    * its next value (`io.room`) is at hand to compute enables a cycle ahead.
+    */
+  protected val advance = RegNext(io.room, false.B)
 
   /** Drives the result and the debug probe from the pipeline's last stage. */
   protected def emit(

@@ -30,6 +30,8 @@ object Fault {
   /** The stream's startup owes the window m+1-n shifts, as a first version did, although more boxes were
     * loaded: for n <= m lane 0 then holds object n, not object 1 (a real bug, found by the whole-run proof). */
   case object WindowFillFromCount extends Fault("the stream's startup fill counts from n, not from the boxes loaded")
+  /** The stream's window enables, computed a cycle ahead, ignore the result queue's back-pressure. */
+  case object LookaheadIgnoresRoom extends Fault("the stream's look-ahead window enables ignore back-pressure")
   /** The batch front end does not count cells of fewer than two objects: later cells get the wrong tag. */
   case object CellCounterSkipsShortCells extends Fault("the batch's cell counter skips cells of 0 or 1 objects")
 
@@ -44,6 +46,7 @@ object Fault {
     SkipSecondBlockAtMPlus2,
     StrictCompare,
     WindowFillFromCount,
+    LookaheadIgnoresRoom,
     CellCounterSkipsShortCells
   )
 }

@@ -42,7 +42,7 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   buffer.io.write.bits.box  := io.write.bits.box
 
   sequencer.io.start   := io.launch
-  sequencer.io.advance := io.advance
+  sequencer.io.advance := advance
   val issue = sequencer.io.issue
 
   // Read back block 0's A objects the cycle after they are written.

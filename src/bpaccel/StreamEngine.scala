@@ -58,8 +58,17 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   // Registered flags only in front of the window's enables (192m flip-flops).
   val filling = RegInit(false.B) // starting && fillLeft != 0
-  val issue   = issuing && io.advance
+  val issue   = issuing && advance
   val fill    = filling
+
+  // The next values of the flags behind the wide enables (window, A block):
+  // the enables are computed from them a cycle ahead, see `replicatedEnable`.
+  val startingNext     = WireDefault(starting)
+  val issuingNext      = WireDefault(issuing)
+  val fillingNext      = WireDefault(filling)
+  starting := startingNext
+  issuing  := issuingNext
+  filling  := fillingNext
 
   // ---- read side: the stream R from R[m] on, read ahead into a small queue ----
   // The memory and its output registers run freely (no enable, no
@@ -157,14 +166,18 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val loadShift  = loadedBox.valid && takesLoads
   val fillOwedNext = Mux(io.clear, (m + 1).U, fillOwed - loadShift.asUInt) // at most m+1 boxes shift in
   fillOwed   := fillOwedNext
-  takesLoads := fillOwedNext =/= 0.U
+  val takesLoadsNext = fillOwedNext =/= 0.U
+  takesLoads := takesLoadsNext
   val entry = Wire(new Entry)
   entry.box := Mux(loadedBox.valid, loadedBox.bits.box.asUInt, readQueue.io.deq.bits.box)
   entry.tag := Mux(loadedBox.valid, tagOf(loadedBox.bits.index), readQueue.io.deq.bits.tag)
-  when(loadShift || fill || issue) {
-    for (k <- 0 until m - 1) window(k) := window(k + 1)
-    window(m - 1) := entry
-  }
+  val windowShift = replicatedEnable(
+    "windowShift",
+    next = (io.write.valid && takesLoadsNext) || fillingNext ||
+      (issuingNext && (io.room || p.has(Fault.LookaheadIgnoresRoom).B)),
+    now = loadShift || fill || issue
+  )
+  for (k <- 0 until m) when(windowShift(k)) { window(k) := (if (k == m - 1) entry else window(k + 1)) }
 
   // ---- A blocks ----
   val a     = Reg(Vec(m, new Entry))
@@ -190,54 +203,62 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // between the issue and the enables of the A registers.
   val blockEnd     = Reg(Bool()) // left == 0
   val hasNextBlock = Reg(Bool()) // blockLeft >= m
+  val blockEndNext     = WireDefault(blockEnd)
+  val hasNextBlockNext = WireDefault(hasNextBlock)
+  blockEnd     := blockEndNext
+  hasNextBlock := hasNextBlockNext
+  // The A block is copied from aNext through the startup and at each block change.
+  val aLoad = replicatedEnable(
+    "aLoad",
+    next = startingNext || (issuingNext && io.room && blockEndNext && hasNextBlockNext),
+    now = starting || (issue && blockEnd && hasNextBlock)
+  )
+  for (k <- 0 until m) when(aLoad(k)) { a(k) := aNext(k) }
   when(starting) {
-    for (k <- 0 until m) a(k) := aNext(k)
     when(primeLeft =/= 0.U) { primeLeft := primeLeft - 1.U }
     when(fillLeft =/= 0.U) { fillLeft := fillLeft - 1.U }
-    filling := fillLeft > 1.U
+    fillingNext := fillLeft > 1.U
     when(primeLeft <= 1.U && fillLeft <= 1.U) {
-      starting := false.B
-      issuing  := true.B
+      startingNext := false.B
+      issuingNext  := true.B
     }
   }
   when(issue) {
     when(!blockEnd) {
       s        := s + 1.U
       left     := left - 1.U
-      blockEnd := left === 1.U
+      blockEndNext := left === 1.U
       capture  := (capture << 1)(m - 1, 0)
     }.elsewhen(hasNextBlock) {
       base         := base + m.U
       s            := base + (m + 1).U
       left         := blockLeft - m.U
       blockLeft    := blockLeft - m.U
-      blockEnd     := blockLeft === m.U
-      hasNextBlock := blockLeft >= (2 * m).U
+      blockEndNext     := blockLeft === m.U
+      hasNextBlockNext := blockLeft >= (2 * m).U
       capture      := 1.U
-      for (k <- 0 until m) a(k) := aNext(k)
     }.otherwise {
-      issuing := false.B
+      issuingNext := false.B
     }
   }
-  when(io.launch.valid) {
-    val count = io.launch.bits // >= 2
+  // Every accepted start loads the run's n-derived registers, launched or
+  // not: they are read only while starting or issuing, so the start's
+  // decoded error checks (the launch) reach only the flags below, not all of
+  // these enables (stream m = 32's critical path).
+  assert(!io.launch.valid || (io.prepare.valid && io.prepare.bits === io.launch.bits), "a launch without its start")
+  when(io.prepare.valid) {
+    val count = io.prepare.bits // >= 2 when it launches
     n         := count
-    starting  := true.B
     primeLeft := p.readLatency.U
     // The last box may shift in during this cycle.
-    if (p.has(Fault.WindowFillFromCount)) {
-      fillLeft := Mux(count <= m.U, (m + 1).U - count, 0.U)
-      filling  := count <= m.U
-    } else {
-      fillLeft := fillOwed - loadShift.asUInt
-      filling  := fillOwed > loadShift.asUInt
-    }
+    fillLeft := (if (p.has(Fault.WindowFillFromCount)) Mux(count <= m.U, (m + 1).U - count, 0.U)
+                 else fillOwed - loadShift.asUInt)
     base      := 0.U
     s         := 1.U
     left      := count - 2.U
     blockLeft := count - 2.U
-    blockEnd     := count === 2.U
-    hasNextBlock := count >= (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 3 else 2)).U
+    blockEndNext     := count === 2.U
+    hasNextBlockNext := count >= (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 3 else 2)).U
     capture   := 1.U
     rBase      := 0.U
     rBlockLeft := count - 2.U
@@ -248,7 +269,11 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     rLeft := Mux(longBlock, count - (m + 2).U, 0.U)
     rBlockEnd     := !longBlock || count === (m + 2).U
     rHasNextBlock := count >= (m + 2).U // rBlockLeft = count-2 >= m
-    readCredits   := readDepth.U
+  }
+  when(io.launch.valid) {
+    startingNext := true.B
+    fillingNext  := (if (p.has(Fault.WindowFillFromCount)) io.launch.bits <= m.U else fillOwed > loadShift.asUInt)
+    readCredits  := readDepth.U
   }
 
   // ---- comparators: registered compare, then registered AND ----
@@ -289,8 +314,21 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   io.activity.active   := starting || issuing
   io.activity.issued   := issue
-  io.activity.stalled  := issuing && !io.advance
+  io.activity.stalled  := issuing && !advance
   io.activity.inFlight := atCompare.valid.asUInt +& atAnd.valid.asUInt
+
+  /** One register per lane holding `next` of the last cycle, checked to equal
+    * `now`: each copy drives one lane's 192 clock enables, where one net
+    * drove all 192m (stream m = 64's critical path: 12.4 ns of routing to
+    * about 12,000 flip-flops). Synthesis merges identical registers unless
+    * told otherwise; the FPGA flow keeps the copies by name (docs/fpga.md).
+    */
+  private def replicatedEnable(name: String, next: Bool, now: Bool): Seq[Bool] =
+    Seq.tabulate(m) { k =>
+      val copy = RegNext(next, false.B).suggestName(s"${name}_replica$k")
+      assert(copy === now, s"the look-ahead of $name is wrong")
+      copy
+    }
 
   val outValid =
     if (p.has(Fault.RepeatLastBeat)) atAnd.valid || (RegNext(atAnd.valid, false.B) && !atAnd.valid) else atAnd.valid

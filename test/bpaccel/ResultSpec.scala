@@ -48,6 +48,17 @@ class ResultSpec extends AnyFlatSpec with Simulators with Checks {
       }
     }
 
+  it should "stop at its own check when the stream's look-ahead enables ignore back-pressure (mutant)" in {
+    val p = AccelParams(m = 3, capacity = 25, arch = Arch.Stream, faults = Set(Fault.LookaheadIgnoresRoom))
+    onVerilator(p) { dut =>
+      val drv   = new AccelDriver(dut)
+      drv.idleInputs()
+      val boxes = Box.Scenes.uniform(new Random(5), 25, p.keyWidth, span = 20, maxExtent = 10)
+      checkRun(p, boxes, drv.run(boxes), consumerNeverStalls = true) // no back-pressure: no difference
+      intercept[ChiselAssertionError](drv.run(boxes, c => c > 60))
+    }
+  }
+
   for (stages <- Seq(0, 1, 3))
     it should s"report exactly the brute-force pairs with $stages memory output stages (m=3)" in {
       val p = AccelParams(m = 3, capacity = 24, memoryOutputStages = stages)
