@@ -95,7 +95,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   queue.io.enq.bits.jBase := beat.bits.jBase
   queue.io.enq.bits.mask  := beat.bits.mask
   queue.io.enq.bits.cell  := batch.io.cell
-  assert(!queue.io.enq.valid || queue.io.enq.ready, "result queue overflow: credit accounting is broken")
+  assert(!queue.io.enq.valid || queue.io.enq.ready, BroadPhaseAccel.ResultQueueOverflow)
   io.result <> queue.io.deq
   if (p.has(Fault.DropBeatWhenNotReady)) queue.io.deq.ready := true.B
 
@@ -126,4 +126,9 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
 
   /** Result-queue entries the credit check counts on (one too many with that mutant's fault). */
   private def creditedEntries: Int = p.resultQueueDepth + (if (p.has(Fault.CreditOneTooMany)) 1 else 0)
+}
+
+object BroadPhaseAccel {
+  /** The message of the design's own check that credits never let a beat meet a full result queue. */
+  val ResultQueueOverflow = "result queue overflow: credit accounting is broken"
 }

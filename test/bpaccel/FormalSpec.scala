@@ -114,7 +114,7 @@ class FormalSpec extends AnyFlatSpec with ChiselScalatestTester with Formal with
     * design's own assertion of the same guarantee, which may fire first.
     */
   private def caughtBy(property: Property): Seq[String] = property match {
-    case Property.ExactlyOnce => Seq(s"[${property.name}]", "result queue overflow")
+    case Property.ExactlyOnce => Seq(s"[${property.name}]", BroadPhaseAccel.ResultQueueOverflow)
     case other                => Seq(s"[${other.name}]")
   }
 
