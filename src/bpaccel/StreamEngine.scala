@@ -53,7 +53,9 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val n        = Reg(UInt(p.countWidth.W))
   val starting = RegInit(false.B)
   val issuing  = RegInit(false.B)
-  val fillLeft = Reg(UInt(p.countWidth.W))              // window shifts still needed at startup
+  // Window shifts still needed at startup, as a thermometer (bit k: more
+  // than k), like `owes` below: the enables' look-ahead reads single bits.
+  val fillLeft = Reg(UInt((m + 1).W))
   val primeLeft = Reg(UInt(log2Ceil(p.readLatency + 1).W)) // cycles until the first read reaches the entry
 
   // Registered flags only in front of the window's enables (192m flip-flops).
@@ -156,18 +158,19 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // window's enables through the port logic (the m = 8 critical path once
   // the load-ready was a register). The last box shifts in at the latest in
   // the cycle of the launch, and the window is not used before the cycle
-  // after it. `fillOwed` counts the shifts the startup still owes the window:
-  // m+1 minus the boxes shifted in since the last start (a start: the next
-  // box is object 0). `takesLoads` is its `=/= 0`, kept as a register because
-  // it gates the window's enables.
+  // after it. The startup still owes the window m+1 minus the boxes shifted
+  // in since the last start (a start: the next box is object 0); `owes`
+  // holds that count as a thermometer, bit k set while it is more than k, so
+  // that counting one down is a shift and the look-ahead of the window's
+  // enables reads single bits instead of a subtraction (stream m = 64).
   val loadedBox  = Pipe(io.write)
-  val fillOwed   = RegInit((m + 1).U(log2Ceil(m + 2).W))
-  val takesLoads = RegInit(true.B)
+  val owes       = RegInit(((BigInt(1) << (m + 1)) - 1).U((m + 1).W))
+  val takesLoads = owes(0)
   val loadShift  = loadedBox.valid && takesLoads
-  val fillOwedNext = Mux(io.clear, (m + 1).U, fillOwed - loadShift.asUInt) // at most m+1 boxes shift in
-  fillOwed   := fillOwedNext
-  val takesLoadsNext = fillOwedNext =/= 0.U
-  takesLoads := takesLoadsNext
+  val owesAfterShift = Mux(loadShift, owes >> 1, owes) // at most m+1 boxes shift in
+  val owesNext       = Mux(io.clear, ((BigInt(1) << (m + 1)) - 1).U, owesAfterShift)
+  owes := owesNext
+  val takesLoadsNext = owesNext(0)
   val entry = Wire(new Entry)
   entry.box := Mux(loadedBox.valid, loadedBox.bits.box.asUInt, readQueue.io.deq.bits.box)
   entry.tag := Mux(loadedBox.valid, tagOf(loadedBox.bits.index), readQueue.io.deq.bits.tag)
@@ -216,9 +219,9 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   for (k <- 0 until m) when(aLoad(k)) { a(k) := aNext(k) }
   when(starting) {
     when(primeLeft =/= 0.U) { primeLeft := primeLeft - 1.U }
-    when(fillLeft =/= 0.U) { fillLeft := fillLeft - 1.U }
-    fillingNext := fillLeft > 1.U
-    when(primeLeft <= 1.U && fillLeft <= 1.U) {
+    fillLeft    := fillLeft >> 1
+    fillingNext := fillLeft(1)
+    when(primeLeft <= 1.U && !fillLeft(1)) {
       startingNext := false.B
       issuingNext  := true.B
     }
@@ -251,8 +254,8 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     n         := count
     primeLeft := p.readLatency.U
     // The last box may shift in during this cycle.
-    fillLeft := (if (p.has(Fault.WindowFillFromCount)) Mux(count <= m.U, (m + 1).U - count, 0.U)
-                 else fillOwed - loadShift.asUInt)
+    fillLeft := (if (p.has(Fault.WindowFillFromCount)) VecInit((0 to m).map(k => count <= (m - k).U)).asUInt // m+1-count > k
+                 else owesAfterShift)
     base      := 0.U
     s         := 1.U
     left      := count - 2.U
@@ -272,7 +275,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   }
   when(io.launch.valid) {
     startingNext := true.B
-    fillingNext  := (if (p.has(Fault.WindowFillFromCount)) io.launch.bits <= m.U else fillOwed > loadShift.asUInt)
+    fillingNext  := (if (p.has(Fault.WindowFillFromCount)) io.launch.bits <= m.U else owesAfterShift(0))
     readCredits  := readDepth.U
   }
 
