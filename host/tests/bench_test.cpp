@@ -44,6 +44,7 @@ std::shared_ptr<DeviceConfig> rtlDevice() {
 LineUpConfig tinyLineUp() {
   LineUpConfig l;
   l.cellSizes = {std::nullopt, 4, 16};
+  l.gridCellSizes = {16};
   l.device = rtlDevice();
   return l;
 }
@@ -168,8 +169,12 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
   for (const auto& row : j["rows"]) {
     EXPECT_TRUE(row.contains("exact_pairs_per_frame_mean"));
     EXPECT_FALSE(row["fastest_baseline"].is_null());
-    // Bullet 3, FCL 3, CGAL 1, ODE 2, then accelerator and cpu per cell size.
-    ASSERT_EQ(row["methods"].size(), 3u + 3u + 1u + 2u + 3u + 3u);
+    // Bullet 3, FCL 3, CGAL 1, ODE 2, then accelerator and cpu per cell size, k-d and grid.
+    ASSERT_EQ(row["methods"].size(), 3u + 3u + 1u + 2u + (3u + 1u) + (3u + 1u));
+    std::set<std::string> gridRows;
+    for (const auto& m : row["methods"])
+      if (m.value("partition", "") == "grid") gridRows.insert(m["name"]);
+    EXPECT_EQ(gridRows, (std::set<std::string>{"accelerator grid 16", "cpu grid 16"}));
     for (const auto& m : row["methods"]) {
       kinds.insert(m["kind"]);
       libraries.insert(m["library"]);
