@@ -114,31 +114,59 @@ std::array<std::uint32_t, 3> UniformGrid::resolution() const {
   return {axes_[0].cells(), axes_[1].cells(), axes_[2].cells()};
 }
 
+// Every box's first cell (its min corner's) is counted branch-free; boxes
+// that straddle a plane (about a third on the bench's scene) are listed and
+// their other cells counted after, so the common case has no branch to
+// mispredict.
 bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
-  const std::uint32_t nx = axes_[0].cells(), ny = axes_[1].cells();
-  const std::uint64_t cap = kMaxEntriesPerBox * boxes.size();
-  std::uint64_t entries = 0;
-  ranges_.resize(boxes.size());
+  const std::uint64_t nx = axes_[0].cells(), ny = axes_[1].cells();
+  firstCell_.resize(boxes.size());
+  straddlers_.resize(boxes.size());
+  straddlerRanges_.resize(boxes.size());
+  // Locals: the loop's stores cannot be seen to leave the tables alone.
+  const std::array<Axis::Lookup, 3> look{axes_[0].lookup(), axes_[1].lookup(), axes_[2].lookup()};
+  std::uint64_t* const counts = offsets_.data();
+  std::uint32_t* const firsts = firstCell_.data();
+  std::uint32_t* const straddlers = straddlers_.data();
+  Range* const ranges = straddlerRanges_.data();
+  std::size_t straddling = 0;
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     const KeyBox& b = boxes[i];
-    Range& r = ranges_[i];
+    Range r;
     for (int a = 0; a < 3; ++a) {
-      r.first[a] = static_cast<std::uint16_t>(axes_[a].cellOf(b.min[a]));
-      r.last[a] = static_cast<std::uint16_t>(axes_[a].cellOf(b.max[a]));
+      r.first[a] = look[a].cellOf(b.min[a]);
+      r.last[a] = look[a].cellOf(b.max[a]);
     }
-    const std::uint64_t joins = std::uint64_t{r.last[0] - r.first[0] + 1u} * (r.last[1] - r.first[1] + 1u) *
-                                (r.last[2] - r.first[2] + 1u);
-    entries += joins;
+    const auto first = static_cast<std::uint32_t>((r.first[2] * ny + r.first[1]) * nx + r.first[0]);
+    firsts[i] = first;
+    ++counts[first];
+    // Appended branch-free: the slot is overwritten unless the box straddles.
+    straddlers[straddling] = static_cast<std::uint32_t>(i);
+    ranges[straddling] = r;
+    straddling += static_cast<std::size_t>((r.first[0] != r.last[0]) | (r.first[1] != r.last[1]) |
+                                           (r.first[2] != r.last[2]));
+  }
+  straddlers_.resize(straddling);
+  straddlerRanges_.resize(straddling);
+  // The straddlers' other cells, within the cap on entries.
+  const std::uint64_t cap = kMaxEntriesPerBox * boxes.size();
+  std::uint64_t entries = boxes.size();
+  for (const Range& r : straddlerRanges_) {
+    entries += std::uint64_t{r.last[0] - r.first[0] + 1u} * (r.last[1] - r.first[1] + 1u) *
+                   (r.last[2] - r.first[2] + 1u) - 1;
     if (entries > cap) return false;
-    if (joins == 1) {
-      ++offsets_[(std::uint64_t{r.first[2]} * ny + r.first[1]) * nx + r.first[0]];
-      continue;
-    }
-    for (std::uint32_t z = r.first[2]; z <= r.last[2]; ++z)
-      for (std::uint32_t y = r.first[1]; y <= r.last[1]; ++y)
-        for (std::uint32_t x = r.first[0]; x <= r.last[0]; ++x) ++offsets_[(std::uint64_t{z} * ny + y) * nx + x];
+    forEachOtherCell(r, [&](std::uint64_t cell) { ++offsets_[cell]; });
   }
   return true;
+}
+
+template <typename F>
+void UniformGrid::forEachOtherCell(const Range& r, F&& f) const {
+  const std::uint64_t nx = axes_[0].cells(), ny = axes_[1].cells();
+  for (std::uint32_t z = r.first[2]; z <= r.last[2]; ++z)
+    for (std::uint32_t y = r.first[1]; y <= r.last[1]; ++y)
+      for (std::uint32_t x = r.first[0]; x <= r.last[0]; ++x)
+        if (x != r.first[0] || y != r.first[1] || z != r.first[2]) f((z * ny + y) * nx + x);
 }
 
 void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell) {
@@ -171,17 +199,20 @@ void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, con
       }
   items_.resize(total);
   packed_.resize(total);
-  // Scatter in box order, so each cell's items are ascending; offsets_ becomes the cursor.
+  // Scatter (offsets_ becomes the cursor): every box into its first cell,
+  // then the straddlers into their others.
   for (std::size_t i = 0; i < boxes.size(); ++i) {
-    const Range& r = ranges_[i];
-    const auto id = static_cast<std::uint32_t>(i);
-    for (std::uint32_t z = r.first[2]; z <= r.last[2]; ++z)
-      for (std::uint32_t y = r.first[1]; y <= r.last[1]; ++y)
-        for (std::uint32_t x = r.first[0]; x <= r.last[0]; ++x) {
-          const std::uint64_t at = offsets_[(std::uint64_t{z} * ny + y) * nx + x]++;
-          items_[at] = id;
-          packed_[at] = boxes[i];
-        }
+    const std::uint64_t at = offsets_[firstCell_[i]]++;
+    items_[at] = static_cast<std::uint32_t>(i);
+    packed_[at] = boxes[i];
+  }
+  for (std::size_t k = 0; k < straddlers_.size(); ++k) {
+    const std::uint32_t id = straddlers_[k];
+    forEachOtherCell(straddlerRanges_[k], [&](std::uint64_t cell) {
+      const std::uint64_t at = offsets_[cell]++;
+      items_[at] = id;
+      packed_[at] = boxes[id];
+    });
   }
   if (!onCell) return;
   for (const Cell& cell : cells_)

@@ -67,7 +67,10 @@ class UniformGrid final : public Partition {
   /// Cells per axis of the last build (without a fallback).
   std::array<std::uint32_t, 3> resolution() const;
   /// Item entries the grid's buffers hold (their capacity).
-  std::size_t storedItems() const { return items_.capacity() + packed_.capacity() + offsets_.capacity(); }
+  std::size_t storedItems() const {
+    return items_.capacity() + packed_.capacity() + offsets_.capacity() + firstCell_.capacity() +
+           straddlers_.capacity() + straddlerRanges_.capacity();
+  }
 
  private:
   // One axis: the bucket table and the planes (planes[c] is the first key of
@@ -79,19 +82,30 @@ class UniformGrid final : public Partition {
     unsigned shift = 0;
     std::uint32_t cells() const { return static_cast<std::uint32_t>(planes.size() - 1); }
     // The cell of a key in [keyLo, keyHi] (every box's keys are).
-    std::uint32_t cellOf(std::uint32_t key) const { return table[(std::uint64_t{key} - keyLo) >> shift]; }
+    struct Lookup {
+      const std::uint16_t* table;
+      std::uint64_t keyLo;
+      unsigned shift;
+      std::uint16_t cellOf(std::uint32_t key) const { return table[(key - keyLo) >> shift]; }
+    };
+    Lookup lookup() const { return {table.data(), keyLo, shift}; }
     void place(std::uint32_t keyLo, std::uint32_t keyHi, std::uint32_t cells);
   };
   static constexpr std::uint64_t kMaxBuckets = 8192;
-  // Fills ranges_ and offsets_ (counts); false when the boxes would join too many cells.
+  struct Range {
+    std::array<std::uint16_t, 3> first, last;  // cells per axis (at most kMaxCellsPerAxis)
+  };
+  // Counts each cell's boxes into offsets_; false when the boxes would join too many cells.
   bool countBoxes(std::span<const KeyBox> boxes);
   void chooseResolution(std::span<const KeyBox> boxes, std::size_t cellSize);
+  // Calls f(cell) for each cell of r but its first.
+  template <typename F>
+  void forEachOtherCell(const Range& r, F&& f) const;
 
   std::array<Axis, 3> axes_;
-  struct Range {
-    std::array<std::uint16_t, 3> first, last;
-  };
-  std::vector<Range> ranges_;            // each box's cells, per axis
+  std::vector<std::uint32_t> firstCell_;  // each box's first cell (its min corner's)
+  std::vector<std::uint32_t> straddlers_;  // boxes in more than one cell, with their ranges
+  std::vector<Range> straddlerRanges_;
   std::vector<std::uint64_t> offsets_;   // per cell: its count, then its first item, then the scatter cursor
   std::vector<std::uint32_t> items_;     // the cells' item lists, in cell order
   std::vector<KeyBox> packed_;           // their boxes, beside them
