@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <optional>
 #include <random>
 
@@ -227,6 +228,69 @@ TEST(UniformGrid, IsExactOnBoxesAtTheEndsOfTheKeyRange) {
       if (!gridOf(bp).fellBack())
         expectCellsPartitionSpaceAndHoldExactlyTheirBoxes(bp.partition(), keys, "key-range ends");
     }
+}
+
+TEST(UniformGrid, BoxesExactlyOnEitherSideOfAPlaneJoinTheRightCells) {
+  // The planes depend only on n, the cell size and the scene's bounds: boxes
+  // replaced by ones at a plane's key and the key below it (the bounds kept)
+  // meet the same planes. Each plane gets a point on either side and a box
+  // from one to the other, whose pairs are reported where the rule says.
+  const std::vector<Aabb> boxes = scatteredBoxes(600, 12, -50, 50, 0.5f, 3);
+  std::vector<KeyBox> keys;
+  toKeys(boxes, keys);
+  UniformGrid grid;
+  grid.build(keys, 16, {});
+  ASSERT_FALSE(grid.fellBack());
+  const std::vector<Cell> before = grid.cells();
+  std::array<std::vector<std::uint32_t>, 3> planes;
+  for (const Cell& c : before)
+    for (int a = 0; a < 3; ++a)
+      if (c.lo[a] > 0) planes[a].push_back(static_cast<std::uint32_t>(c.lo[a]));
+  for (auto& p : planes) {
+    std::sort(p.begin(), p.end());
+    p.erase(std::unique(p.begin(), p.end()), p.end());
+    ASSERT_GE(p.size(), 2u);
+  }
+  std::array<std::uint32_t, 3> mid{};
+  for (int a = 0; a < 3; ++a) mid[a] = floatToKey(0.0f);
+  std::array<std::uint32_t, 3> keyLo{~0u, ~0u, ~0u}, keyHi{0, 0, 0};
+  for (const KeyBox& k : keys)
+    for (int a = 0; a < 3; ++a) keyLo[a] = std::min(keyLo[a], k.min[a]), keyHi[a] = std::max(keyHi[a], k.max[a]);
+  std::vector<KeyBox> edited = keys;
+  std::size_t slot = 0;
+  const auto put = [&](const KeyBox& k) {
+    // Never overwrite a box that holds the scene's bounds.
+    for (bool bounds = true; bounds; ++slot) {
+      bounds = false;
+      for (int a = 0; a < 3; ++a)
+        bounds = bounds || edited[slot].min[a] == keyLo[a] || edited[slot].max[a] == keyHi[a];
+      if (!bounds) edited[slot] = k;
+    }
+  };
+  for (int a = 0; a < 3; ++a)
+    for (std::uint32_t p : planes[a]) {
+      KeyBox below{mid, mid}, at{mid, mid}, across{mid, mid};
+      below.min[a] = below.max[a] = p - 1;
+      at.min[a] = at.max[a] = p;
+      across.min[a] = p - 1;
+      across.max[a] = p;
+      put(below);
+      put(at);
+      put(across);
+    }
+  grid.build(edited, 16, {});
+  ASSERT_FALSE(grid.fellBack());
+  ASSERT_EQ(grid.cells().size(), before.size());
+  for (std::size_t c = 0; c < before.size(); ++c) {
+    EXPECT_EQ(grid.cells()[c].lo, before[c].lo);
+    EXPECT_EQ(grid.cells()[c].hi, before[c].hi);
+  }
+  expectCellsPartitionSpaceAndHoldExactlyTheirBoxes(grid, edited, "boxes on the planes");
+  CpuBackend cpu;
+  BroadPhase bp(cpu, 16, 1, PartitionKind::UniformGrid);
+  std::vector<Pair> pairs;
+  bp.findPairs(std::span<const KeyBox>(edited), pairs);
+  EXPECT_EQ(sorted(pairs), bruteForceKeys(edited));
 }
 
 TEST(Partition, KindsParseFromTheCliSpellingAndRejectOthers) {
