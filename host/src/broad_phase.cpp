@@ -50,7 +50,7 @@ struct BroadPhase::Worker {
   std::vector<std::size_t> cellEnds;
 
   // One device cell: a partition cell or a chunk pair. `packed`: its boxes in item
-  // order when the caller has them (the grid's cells, carried tree leaves, the whole scene), else
+  // order when the caller has them (carried tree leaves, the whole scene), else
   // empty: they are gathered from `keys`.
   void submit(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
               const Cell* region, std::size_t splitAt, int keep);

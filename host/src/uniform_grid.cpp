@@ -120,9 +120,12 @@ std::array<std::uint32_t, 3> UniformGrid::resolution() const {
 // mispredict.
 bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
   const std::uint64_t nx = axes_[0].cells(), ny = axes_[1].cells();
-  firstCell_.resize(boxes.size());
-  straddlers_.resize(boxes.size());
-  straddlerRanges_.resize(boxes.size());
+  // Grow only: value-initialising the tail again every frame would cost a pass.
+  if (firstCell_.size() < boxes.size()) {
+    firstCell_.resize(boxes.size());
+    straddlers_.resize(boxes.size());
+    straddlerRanges_.resize(boxes.size());
+  }
   // Locals: the loop's stores cannot be seen to leave the tables alone.
   const std::array<Axis::Lookup, 3> look{axes_[0].lookup(), axes_[1].lookup(), axes_[2].lookup()};
   std::uint64_t* const counts = offsets_.data();
@@ -146,12 +149,11 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
     straddling += static_cast<std::size_t>((r.first[0] != r.last[0]) | (r.first[1] != r.last[1]) |
                                            (r.first[2] != r.last[2]));
   }
-  straddlers_.resize(straddling);
-  straddlerRanges_.resize(straddling);
+  straddling_ = straddling;
   // The straddlers' other cells, within the cap on entries.
   const std::uint64_t cap = kMaxEntriesPerBox * boxes.size();
   std::uint64_t entries = boxes.size();
-  for (const Range& r : straddlerRanges_) {
+  for (const Range& r : std::span<const Range>(straddlerRanges_).first(straddling_)) {
     entries += std::uint64_t{r.last[0] - r.first[0] + 1u} * (r.last[1] - r.first[1] + 1u) *
                    (r.last[2] - r.first[2] + 1u) - 1;
     if (entries > cap) return false;
@@ -198,26 +200,15 @@ void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, con
         total += count;
       }
   items_.resize(total);
-  packed_.resize(total);
   // Scatter (offsets_ becomes the cursor): every box into its first cell,
   // then the straddlers into their others.
-  for (std::size_t i = 0; i < boxes.size(); ++i) {
-    const std::uint64_t at = offsets_[firstCell_[i]]++;
-    items_[at] = static_cast<std::uint32_t>(i);
-    packed_[at] = boxes[i];
-  }
-  for (std::size_t k = 0; k < straddlers_.size(); ++k) {
+  for (std::size_t i = 0; i < boxes.size(); ++i) items_[offsets_[firstCell_[i]]++] = static_cast<std::uint32_t>(i);
+  for (std::size_t k = 0; k < straddling_; ++k) {
     const std::uint32_t id = straddlers_[k];
-    forEachOtherCell(straddlerRanges_[k], [&](std::uint64_t cell) {
-      const std::uint64_t at = offsets_[cell]++;
-      items_[at] = id;
-      packed_[at] = boxes[id];
-    });
+    forEachOtherCell(straddlerRanges_[k], [&](std::uint64_t cell) { items_[offsets_[cell]++] = id; });
   }
   if (!onCell) return;
-  for (const Cell& cell : cells_)
-    onCell(cell, {items_.data() + cell.begin, cell.count},
-           std::span<const KeyBox>(packed_).subspan(static_cast<std::size_t>(cell.begin), cell.count));
+  for (const Cell& cell : cells_) onCell(cell, {items_.data() + cell.begin, cell.count}, {});
 }
 
 }  // namespace bpaccel
