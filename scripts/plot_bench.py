@@ -93,6 +93,7 @@ def plot_parts(rows, out):
         ax.bar(names, xfer, bottom=[h + d for h, d in zip(host, dev)], label="transfer (modelled)")
         ax.set_title(f"n = {r['objects']}")
         ax.set_xlabel("partition and cell size")
+        ax.tick_params(axis="x", labelrotation=45)
         ax.set_ylabel("ms per frame (median)")
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
