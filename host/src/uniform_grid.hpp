@@ -14,14 +14,15 @@ namespace bpaccel {
 
 /// A counting sort of the boxes into the cells of a grid: one pass finds each
 /// box's range of cells and counts the cells' boxes, a prefix sum places the
-/// cells, a second pass scatters the boxes' indices. Cells are handed over
-/// with indices only (BroadPhase gathers their boxes): scattering the boxes
-/// too was measured slower per frame (bpaccel pairs --repeat, 8000 boxes):
-/// with the device simulated between frames its 24 bytes a box land in cold
-/// cache lines, and a batch copies them again anyway. A box that straddles grid planes joins every cell it
-/// touches; cells are half-open regions [lo, hi) that cover key space (the
-/// outer planes are 0 and 2^32), so the reference-point rule of BroadPhase
-/// holds exactly as on the tree.
+/// cells, a second pass scatters the boxes' indices. A box that straddles
+/// grid planes joins every cell it touches; cells are half-open regions
+/// [lo, hi) that cover key space (the outer planes are 0 and 2^32), so the
+/// reference-point rule of BroadPhase holds exactly as on the tree.
+///
+/// Cells are handed over with indices only (BroadPhase gathers their boxes):
+/// scattering the boxes too was measured slower per frame (bpaccel pairs
+/// --repeat, 8000 boxes): with the device simulated between frames their 24
+/// bytes a box land in cold cache lines, and a batch copies them again anyway.
 ///
 /// Resolution: the planes are evenly spaced in float space (world units)
 /// between the scene's lowest box minimum and highest box maximum, since keys
@@ -45,13 +46,13 @@ namespace bpaccel {
 /// eighth of a cell (at most kMaxBuckets buckets: beyond, cells snap to
 /// coarser steps, still exactly).
 ///
-/// Bounds on memory: at most kMaxCellsPerAxis cells per axis and
-/// ceil(2n / cellSize) cells (rounded per axis) in all. Boxes that are large
-/// against the cells (or a few that span the scene) would join many cells: once the
-/// cells joined exceed kMaxEntriesPerBox per box, the build stops and falls back
-/// to the k-d tree for this frame, which never copies more than a quarter of
-/// a node's boxes into both children. The work before the fallback is
-/// bounded by the same cap.
+/// Bounds on memory: at most kMaxCellsPerAxis cells per axis and about
+/// ceil(2n / cellSize) cells in all (each axis's count rounded). Boxes large
+/// against the cells would join many cells: once the cells joined exceed
+/// kMaxEntriesPerBox per box, the build stops and falls back to the k-d tree
+/// for this frame, which never copies more than a quarter of a node's boxes
+/// into both children. The work before the fallback is bounded by the same
+/// cap.
 class UniformGrid final : public Partition {
  public:
   static constexpr std::uint64_t kMaxEntriesPerBox = 4;
