@@ -18,11 +18,16 @@ namespace {
 
 const UniformGrid& gridOf(const BroadPhase& bp) { return dynamic_cast<const UniformGrid&>(bp.partition()); }
 
-void expectExactOnGrid(Backend& backend, const std::vector<Aabb>& boxes, std::size_t cell, const std::string& what) {
+void expectExactOnGrid(Backend& backend, const std::vector<Aabb>& boxes, std::size_t cell, const std::string& what,
+                       const std::vector<Pair>& exact) {
   BroadPhase bp(backend, cell, 1, PartitionKind::UniformGrid);
   std::vector<Pair> pairs;
   bp.findPairs(boxes, pairs);
-  EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << what << " backend " << backend.name() << " cell " << cell;
+  EXPECT_EQ(sorted(pairs), exact) << what << " backend " << backend.name() << " cell " << cell;
+}
+
+void expectExactOnGrid(Backend& backend, const std::vector<Aabb>& boxes, std::size_t cell, const std::string& what) {
+  expectExactOnGrid(backend, boxes, cell, what, bruteForce(boxes));
 }
 
 // All pairs by the definition, on keys (for scenes given as keys).
@@ -77,11 +82,13 @@ TEST(UniformGrid, ModelAndCpuAreExactOnAdversarialScenesForEveryCellSize) {
   ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
   CpuBackend cpu;
   for (std::size_t n : {0u, 1u, 2u, 7u, 150u, 600u})
-    for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 11))
+    for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 11)) {
+      const auto exact = bruteForce(boxes);  // once a scene: the sanitizer build runs this test too
       for (std::size_t cell : {1u, 2u, 3u, 5u, 8u, 16u, 32u, 64u, 256u}) {
-        expectExactOnGrid(model, boxes, cell, name + " n=" + std::to_string(n));
-        expectExactOnGrid(cpu, boxes, cell, name + " n=" + std::to_string(n));
+        expectExactOnGrid(model, boxes, cell, name + " n=" + std::to_string(n), exact);
+        expectExactOnGrid(cpu, boxes, cell, name + " n=" + std::to_string(n), exact);
       }
+    }
 }
 
 TEST(UniformGrid, CellsPartitionKeySpaceAndHoldEveryBoxTheyTouch) {
