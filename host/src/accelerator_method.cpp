@@ -27,6 +27,7 @@ FrameTime AcceleratorMethod::frameTime(double measuredSeconds) const {
   ModelledParts p;
   p.stats = phase_.stats();
   p.hostSeconds = measuredSeconds - phase_.times().backendSeconds;  // simulating the device is not host work
+  p.partitionSeconds = phase_.times().partitionSeconds;
   p.deviceSeconds = static_cast<double>(p.stats.deviceCycles()) / device_->clockHz;
   p.transferSeconds = device_->link.seconds(p.stats, device_->beatBytes, device_->clockHz);
   const PipelineModel model{device_->clockHz, device_->link.bandwidthBytesPerSecond, device_->link.latencySecondsPerRun,

@@ -55,7 +55,7 @@ struct Entry {
   std::unique_ptr<TimedMethod> method;
   std::optional<std::string> skipped;
   double setupSeconds = 0, updateSeconds = 0;
-  std::vector<double> frameSeconds, hostSeconds, deviceSeconds, transferSeconds;
+  std::vector<double> frameSeconds, hostSeconds, partitionSeconds, deviceSeconds, transferSeconds;
   std::vector<double> deviceCycles, loadCycles, cycles, runs, batches, boxesSent;
   std::vector<double> pipelinedSeconds;           // modelled overlap of the same frames
   std::shared_ptr<const FrameTimeline> timeline;  // the last timed frame's, for the plot
@@ -326,6 +326,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
       e.frameSeconds.push_back(ft.seconds);
       if (const auto& p = ft.parts) {
         e.hostSeconds.push_back(p->hostSeconds);
+        e.partitionSeconds.push_back(p->partitionSeconds);
         e.deviceSeconds.push_back(p->deviceSeconds);
         e.transferSeconds.push_back(p->transferSeconds);
         e.deviceCycles.push_back(static_cast<double>(p->stats.deviceCycles()));
@@ -404,6 +405,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
     j["update_s_total"] = e.updateSeconds;
     if (!e.hostSeconds.empty()) {
       j["host_ms_measured"] = summary(e.hostSeconds, 1e3);
+      j["host_partition_ms_measured"] = summary(e.partitionSeconds, 1e3);
       j["device_ms_modelled"] = summary(e.deviceSeconds, 1e3);
       j["transfer_ms_modelled"] = summary(e.transferSeconds, 1e3);
       j["device_cycles"] = summary(e.deviceCycles, 1);

@@ -29,6 +29,7 @@ bool mustBeExact(MethodKind kind);
 /// Parts of a frame whose device and link are modelled, not measured.
 struct ModelledParts {
   double hostSeconds = 0;      // measured on this machine
+  double partitionSeconds = 0; // measured: the part of hostSeconds that built the partition (k-d tree or grid)
   double deviceSeconds = 0;    // modelled: device cycles / clock
   double transferSeconds = 0;  // modelled: link model
   RunStats stats;              // the device's counters for the frame

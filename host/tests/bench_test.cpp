@@ -184,7 +184,8 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
       if (m["kind"] == "accelerator" || m["kind"] == "cpu") EXPECT_EQ(m["missing_pairs"], 0) << m["name"];
       EXPECT_EQ(m["acceleration_over"].size(), 9u);
       if (m["kind"] == "accelerator")
-        for (const char* part : {"host_ms_measured", "device_ms_modelled", "transfer_ms_modelled", "device_cycles",
+        for (const char* part : {"host_ms_measured", "host_partition_ms_measured", "device_ms_modelled",
+                                 "transfer_ms_modelled", "device_cycles",
                                  "load_cycles", "runs", "batches", "serial_frame_ms", "pipelined_frame_ms_modelled"})
           EXPECT_TRUE(m.contains(part)) << part;
       if (m["kind"] == "accelerator") {
@@ -193,6 +194,13 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
                   m["device_ms_modelled"]["min"].get<double>())
             << m["name"];
         EXPECT_EQ(m["serial_frame_ms"], m["frame_ms"]) << m["name"];
+        // The partition is a part of the host's work, and only rows with a cell size build one.
+        const double partition = m["host_partition_ms_measured"]["median"].get<double>();
+        EXPECT_LE(partition, m["host_ms_measured"]["median"].get<double>()) << m["name"];
+        if (m["cell_size"] == "none")
+          EXPECT_EQ(partition, 0) << m["name"];
+        else
+          EXPECT_GT(partition, 0) << m["name"];
       }
     }
     // The timeline of the row's best accelerator method: one device span per hand-over.
