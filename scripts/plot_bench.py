@@ -27,7 +27,8 @@ def plot_acceleration(rows, cfg, out):
             xs, ys = [], []
             for r in rows:
                 base = r.get("fastest_baseline")
-                m = next((m for m in r["methods"] if m["kind"] == kind and str(m["cell_size"]) == cell), None)
+                m = next((m for m in r["methods"] if m["kind"] == kind and str(m["cell_size"]) == cell
+                          and m.get("partition", "k-d") == "k-d"), None)
                 if base and m and ran(m):
                     xs.append(r["objects"])
                     ys.append(base["frame_ms"] / m["frame_ms"]["median"])
@@ -83,7 +84,7 @@ def plot_parts(rows, out):
     fig, axes = plt.subplots(1, len(rows), figsize=(4 * len(rows), 4), squeeze=False)
     for ax, r in zip(axes[0], rows):
         accel = [m for m in r["methods"] if m["kind"] == "accelerator" and ran(m)]
-        names = [str(m["cell_size"]) for m in accel]
+        names = [f'{m.get("partition", "k-d")} {m["cell_size"]}' for m in accel]
         host = [m["host_ms_measured"]["median"] for m in accel]
         dev = [m["device_ms_modelled"]["median"] for m in accel]
         xfer = [m["transfer_ms_modelled"]["median"] for m in accel]
@@ -91,7 +92,8 @@ def plot_parts(rows, out):
         ax.bar(names, dev, bottom=host, label="device, loads included (modelled)")
         ax.bar(names, xfer, bottom=[h + d for h, d in zip(host, dev)], label="transfer (modelled)")
         ax.set_title(f"n = {r['objects']}")
-        ax.set_xlabel("k-d tree cell size")
+        ax.set_xlabel("partition and cell size")
+        ax.tick_params(axis="x", labelrotation=45)
         ax.set_ylabel("ms per frame (median)")
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
@@ -100,7 +102,7 @@ def plot_parts(rows, out):
 
 
 TIMELINE_LANES = (
-    ("produce", "host: keys, tree, packing\n(measured)", "tab:blue"),
+    ("produce", "host: keys, partition, packing\n(measured)", "tab:blue"),
     ("link", "link (modelled)", "tab:orange"),
     ("device", "device: load + compute\n(modelled)", "tab:red"),
     ("decode", "host: decode, filter\n(measured)", "tab:green"),

@@ -1,6 +1,6 @@
 // bpaccel: command-line front end of the host.
 //
-//   bpaccel pairs --input FILE [--backend rtl|model|cpu] [--cell-size C|none] [--stats]
+//   bpaccel pairs --input FILE [--backend rtl|model|cpu] [--cell-size C|none] [--partition kd|grid] [--stats]
 
 #include <algorithm>
 #include <filesystem>
@@ -48,8 +48,13 @@ std::optional<std::size_t> parseCellSize(const std::string& text) {
   return static_cast<std::size_t>(v);
 }
 
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : (v[(v.size() - 1) / 2] + v[v.size() / 2]) / 2;
+}
+
 int runPairs(const std::string& input, const std::string& backendName, const std::string& cellSizeText,
-             std::size_t cellsPerBatch, bool stats) {
+             bpaccel::PartitionKind partition, std::size_t cellsPerBatch, std::size_t repeat, bool stats) {
   std::ifstream file(input);
   if (!file) {
     fmt::print(stderr, "bpaccel: cannot open '{}'\n", input);
@@ -63,9 +68,19 @@ int runPairs(const std::string& input, const std::string& backendName, const std
     return 1;
   }
   auto backend = makeBackend(backendName);
-  bpaccel::BroadPhase broadPhase(*backend, parseCellSize(cellSizeText), cellsPerBatch);
+  bpaccel::BroadPhase broadPhase(*backend, parseCellSize(cellSizeText), cellsPerBatch, partition);
   std::vector<bpaccel::Pair> pairs;
-  broadPhase.findPairs(boxes, pairs);
+  // Each part's host time per repetition; --stats prints their medians.
+  std::vector<double> convert, partitionTime, cells, total, host;
+  for (std::size_t r = 0; r < repeat; ++r) {
+    broadPhase.findPairs(boxes, pairs);
+    const auto& t = broadPhase.times();
+    convert.push_back(t.convertSeconds);
+    partitionTime.push_back(t.partitionSeconds);
+    cells.push_back(t.cellsSeconds);
+    total.push_back(t.totalSeconds);
+    host.push_back(t.totalSeconds - t.backendSeconds);
+  }
   std::sort(pairs.begin(), pairs.end());
 
   std::string text;
@@ -75,14 +90,14 @@ int runPairs(const std::string& input, const std::string& backendName, const std
 
   if (stats) {
     const auto& s = broadPhase.stats();
-    const auto& t = broadPhase.times();
     fmt::print(stderr,
-               "backend {} cell-size {} objects {} pairs {}\n"
+               "backend {} cell-size {} partition {} objects {} pairs {}\n"
                "runs {} batches {} cycles {} issue-cycles {} stall-cycles {} hits {} boxes-sent {} beats {}\n"
-               "host seconds (measured): convert {:.6f} tree {:.6f} cells {:.6f} total {:.6f}\n",
-               backend->name(), cellSizeText, boxes.size(), pairs.size(), s.runs, s.batches, s.cycles, s.issueCycles,
-               s.stallCycles, s.hits, s.boxesSent, s.beatsReceived, t.convertSeconds, t.treeSeconds,
-               t.cellsSeconds, t.totalSeconds);
+               "host seconds (measured): convert {:.6f} partition {:.6f} cells {:.6f} total {:.6f} "
+               "host-without-backend {:.6f} (median of {} frames)\n",
+               backend->name(), cellSizeText, broadPhase.partition().name(), boxes.size(), pairs.size(), s.runs,
+               s.batches, s.cycles, s.issueCycles, s.stallCycles, s.hits, s.boxesSent, s.beatsReceived,
+               median(convert), median(partitionTime), median(cells), median(total), median(host), repeat);
   }
   return 0;
 }
@@ -175,13 +190,24 @@ int main(int argc, char** argv) {
   pairs->add_option("--backend", backendName, "rtl (Verilated hardware), model (its C++ model) or cpu (software)")
       ->check(CLI::IsMember({"rtl", "model", "cpu"}))
       ->capture_default_str();
-  pairs->add_option("--cell-size", cellSize, "k-d tree cell size C (most boxes a leaf holds) or 'none'")
+  pairs->add_option("--cell-size", cellSize,
+                    "Cell size C (k-d: most boxes a leaf holds; grid: 2n/C cells) or 'none' (one cell)")
+      ->capture_default_str();
+  std::string partitionName = "kd";
+  pairs->add_option("--partition", partitionName,
+                    "How cells are made: kd (k-d tree, any scene) or grid (uniform grid, near-uniform scenes; "
+                    "falls back to the tree when boxes would join too many cells)")
+      ->check(CLI::IsMember({"kd", "grid"}))
       ->capture_default_str();
   std::size_t pairsCellsPerBatch = 1;
   pairs->add_option("--cells-per-batch", pairsCellsPerBatch,
                     "Cells per hand-over to the backend (the hardware's batch front end); 1: each on its own")
       ->check(CLI::PositiveNumber)->capture_default_str();
   pairs->add_flag("--stats", stats, "Print cycles and timings to stderr");
+  std::size_t repeat = 1;
+  pairs->add_option("--repeat", repeat,
+                    "Find the pairs this many times (frames on the same scene); --stats gives each host part's median")
+      ->check(CLI::PositiveNumber)->capture_default_str();
 
   bpaccel::BenchConfig bench;
   bench.wholeStepObjects = 8000;
@@ -207,6 +233,10 @@ int main(int argc, char** argv) {
   benchCmd->add_option("--objects", bench.objectCounts, "Object counts, one table row each")->capture_default_str()
       ->check(CLI::PositiveNumber);
   benchCmd->add_option("--cell-sizes", benchCells, "k-d tree cell sizes ('none' = no tree)")->capture_default_str();
+  benchCmd->add_option("--grid-cell-sizes", lineUp.gridCellSizes,
+                       "Cell sizes of the extra 'accelerator grid C' and 'cpu grid C' rows (uniform grid partition)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   benchCmd->add_option("--backend", benchBackend, "Where device cycles come from: rtl (Verilated) or model")
       ->check(CLI::IsMember({"rtl", "model"}))->capture_default_str();
   benchCmd->add_option("--frames", bench.frames, "Timed frames per row")->check(CLI::PositiveNumber)->capture_default_str();
@@ -261,7 +291,8 @@ int main(int argc, char** argv) {
     }
     if (*sceneCmd) return runScene(sceneConfig, sceneFrames, sceneOut);
     parseCellSize(cellSize);
-    return runPairs(input, backendName, cellSize, pairsCellsPerBatch, stats);
+    return runPairs(input, backendName, cellSize, bpaccel::parsePartitionKind(partitionName), pairsCellsPerBatch,
+                    repeat, stats);
   } catch (const CLI::ValidationError& e) {
     fmt::print(stderr, "bpaccel: {}\n", e.what());
     return 2;

@@ -13,6 +13,7 @@ set(_bpaccel_src ${CMAKE_CURRENT_LIST_DIR}/../src)
 # and the configuration the model backend is built for (bpaccel_params.h).
 target_sources(bpaccel_core PUBLIC FILE_SET HEADERS BASE_DIRS ${_bpaccel_src} ${BPACCEL_VERILOG_DIR} FILES
   ${_bpaccel_src}/types.hpp ${_bpaccel_src}/all_pairs_kernel.hpp ${_bpaccel_src}/backend.hpp ${_bpaccel_src}/keys.hpp ${_bpaccel_src}/kd_tree.hpp
+  ${_bpaccel_src}/partition.hpp ${_bpaccel_src}/uniform_grid.hpp
   ${_bpaccel_src}/broad_phase.hpp ${_bpaccel_src}/timeline.hpp ${_bpaccel_src}/box_file.hpp ${BPACCEL_VERILOG_DIR}/bpaccel_params.h)
 # Installed users include <bpaccel/...> (the file set adds include/bpaccel/).
 target_include_directories(bpaccel_core INTERFACE $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)

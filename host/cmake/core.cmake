@@ -6,7 +6,9 @@ add_library(bpaccel_core STATIC
   ${CMAKE_CURRENT_LIST_DIR}/../src/box_file.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/backend.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/all_pairs_kernel.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/../src/partition.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/kd_tree.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/../src/uniform_grid.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/broad_phase.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/timeline.cpp)
 # A build-tree path: the installed package (bullet_drop_in.cmake) adds its own.

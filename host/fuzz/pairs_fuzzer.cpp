@@ -1,5 +1,6 @@
 // The pair-finding API on any scene decoded from the bytes: BroadPhase with
-// the cpu and the model backend, with and without a k-d tree, returns exactly
+// the cpu and the model backend, with and without a k-d tree, and with a
+// uniform grid (same cell size; it may hand the scene to the tree), returns exactly
 // the pairs of a brute-force test on the floats, each once. Scenes mix
 // infinities, denormals, signed zeros, float extremes, a coarse integer grid
 // (touching faces), raw float bits and repeated boxes. The model runs with a
@@ -9,7 +10,7 @@
 //
 // Input layout (read front to back; missing bytes read as 0), so seeds can be
 // written by hand (host/fuzz/README.md):
-//   cell byte: 0 = no k-d tree, else cell size 1 + (byte - 1) % 40
+//   cell byte: 0 = no partition, else cell size 1 + (byte - 1) % 40 (k-d tree and grid)
 //   m byte: model lanes 1 + byte % 8; bits 3-4: the model's cells per hand-over
 //   1 + 3 * bits (1, 4, 7, 10); bits 5-6: its hardware batch 1 + bits cells
 //   (a hand-over beyond it is split); with bit 7 set the model with the k-d
@@ -209,6 +210,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     setups.push_back({fmt::format("model m {} capacity {} cell {} batch {}/{}", m, capacity, cellName, cellsPerBatch,
                                   batchCells),
                       [&model, c, cellsPerBatch] { return std::make_unique<BroadPhase>(model, c, cellsPerBatch); }});
+  }
+  if (cell) {
+    setups.push_back({"cpu grid cell " + std::to_string(*cell), [&cpu, cell] {
+                        return std::make_unique<BroadPhase>(cpu, cell, 1, PartitionKind::UniformGrid);
+                      }});
+    setups.push_back({fmt::format("model m {} capacity {} grid cell {} batch {}/{}", m, capacity, *cell,
+                                  cellsPerBatch, batchCells),
+                      [&model, cell, cellsPerBatch] {
+                        return std::make_unique<BroadPhase>(model, cell, cellsPerBatch, PartitionKind::UniformGrid);
+                      }});
   }
   if (threads > 1 && cell) {
     const auto makeModel = [m, capacity, batchCells]() -> std::unique_ptr<Backend> {

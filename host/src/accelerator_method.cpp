@@ -17,13 +17,17 @@ double LinkModel::seconds(const RunStats& s, std::size_t bytesPerBeat, double cl
 
 std::string cellName(const std::optional<std::size_t>& c) { return c ? std::to_string(*c) : "none"; }
 
-AcceleratorMethod::AcceleratorMethod(std::shared_ptr<const DeviceConfig> device, std::optional<std::size_t> cellSize)
-    : device_(std::move(device)), backend_(device_->makeBackend()), phase_(*backend_, cellSize, device_->cellsPerBatch) {}
+AcceleratorMethod::AcceleratorMethod(std::shared_ptr<const DeviceConfig> device, std::optional<std::size_t> cellSize,
+                                     PartitionKind partition)
+    : device_(std::move(device)),
+      backend_(device_->makeBackend()),
+      phase_(*backend_, cellSize, device_->cellsPerBatch, partition) {}
 
 FrameTime AcceleratorMethod::frameTime(double measuredSeconds) const {
   ModelledParts p;
   p.stats = phase_.stats();
   p.hostSeconds = measuredSeconds - phase_.times().backendSeconds;  // simulating the device is not host work
+  p.partitionSeconds = phase_.times().partitionSeconds;
   p.deviceSeconds = static_cast<double>(p.stats.deviceCycles()) / device_->clockHz;
   p.transferSeconds = device_->link.seconds(p.stats, device_->beatBytes, device_->clockHz);
   const PipelineModel model{device_->clockHz, device_->link.bandwidthBytesPerSecond, device_->link.latencySecondsPerRun,
@@ -34,17 +38,20 @@ FrameTime AcceleratorMethod::frameTime(double measuredSeconds) const {
 
 namespace {
 
-// One method per cell size; without a tree a method tests all pairs.
-std::vector<MethodSpec> perCellSize(const std::string& prefix, MethodKind kind,
+// One method per cell size; without a cell size a method tests all pairs,
+// which only the k-d line-up holds (the grid's "none" would be the same method).
+std::vector<MethodSpec> perCellSize(const std::string& prefix, MethodKind kind, PartitionKind partition,
                                     const std::vector<std::optional<std::size_t>>& cellSizes, double maxAllPairsTests,
                                     const std::function<std::unique_ptr<TimedMethod>(std::optional<std::size_t>)>& make) {
   std::vector<MethodSpec> specs;
   for (const auto& c : cellSizes) {
+    if (!c && partition != PartitionKind::KdTree) continue;
     MethodSpec s;
-    s.name = prefix + " k-d " + cellName(c);
+    s.name = fmt::format("{} {} {}", prefix, partitionName(partition), cellName(c));
     s.kind = kind;
     s.library = "bpaccel";
     s.cellSize = c;
+    s.partition = partitionName(partition);
     if (!c) s.skipReason = allPairsSkipReason(maxAllPairsTests);
     s.make = [make, c](const SceneStart&) { return make(c); };
     specs.push_back(std::move(s));
@@ -56,11 +63,13 @@ std::vector<MethodSpec> perCellSize(const std::string& prefix, MethodKind kind,
 
 std::vector<MethodSpec> acceleratorMethods(std::shared_ptr<const DeviceConfig> device,
                                            const std::vector<std::optional<std::size_t>>& cellSizes,
-                                           double maxAllPairsTests) {
+                                           double maxAllPairsTests, PartitionKind partition) {
   if (!device || !device->makeBackend) throw std::invalid_argument("bench: the accelerator needs a device backend");
   if (!(device->clockHz > 0)) throw std::invalid_argument("bench: clock must be positive");
-  return perCellSize("accelerator", MethodKind::Accelerator, cellSizes, maxAllPairsTests,
-                     [device](std::optional<std::size_t> c) { return std::make_unique<AcceleratorMethod>(device, c); });
+  return perCellSize("accelerator", MethodKind::Accelerator, partition, cellSizes, maxAllPairsTests,
+                     [device, partition](std::optional<std::size_t> c) {
+                       return std::make_unique<AcceleratorMethod>(device, c, partition);
+                     });
 }
 
 std::vector<MethodSpec> threadedCpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, std::size_t threads) {
@@ -69,6 +78,7 @@ std::vector<MethodSpec> threadedCpuMethods(const std::vector<std::optional<std::
     if (!c) continue;  // one cell: nothing to share out
     MethodSpec s;
     s.name = fmt::format("cpu k-d {}, {} threads", *c, threads);
+    s.partition = partitionName(PartitionKind::KdTree);
     s.kind = MethodKind::Cpu;
     s.library = "bpaccel";
     s.cellSize = c;
@@ -78,9 +88,10 @@ std::vector<MethodSpec> threadedCpuMethods(const std::vector<std::optional<std::
   return specs;
 }
 
-std::vector<MethodSpec> cpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, double maxAllPairsTests) {
-  return perCellSize("cpu", MethodKind::Cpu, cellSizes, maxAllPairsTests,
-                     [](std::optional<std::size_t> c) { return std::make_unique<CpuMethod>(c); });
+std::vector<MethodSpec> cpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, double maxAllPairsTests,
+                                   PartitionKind partition) {
+  return perCellSize("cpu", MethodKind::Cpu, partition, cellSizes, maxAllPairsTests,
+                     [partition](std::optional<std::size_t> c) { return std::make_unique<CpuMethod>(c, 1, partition); });
 }
 
 DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std::string& arch) {

@@ -61,7 +61,8 @@ struct DeviceConfig {
 /// BroadPhase on the device: host part measured, device and link modelled.
 class AcceleratorMethod final : public TimedMethod {
  public:
-  AcceleratorMethod(std::shared_ptr<const DeviceConfig> device, std::optional<std::size_t> cellSize);
+  AcceleratorMethod(std::shared_ptr<const DeviceConfig> device, std::optional<std::size_t> cellSize,
+                    PartitionKind partition = PartitionKind::KdTree);
   void update(std::span<const Aabb> boxes) override { phase_.findPairs(boxes, pairs_); }
   void pairs(std::vector<Pair>& out) override { out = pairs_; }
   /// Host = measured wall time minus the time spent simulating the device;
@@ -79,8 +80,9 @@ class AcceleratorMethod final : public TimedMethod {
 /// threads the tree is built on one and its cells shared out among them.
 class CpuMethod final : public TimedMethod {
  public:
-  explicit CpuMethod(std::optional<std::size_t> cellSize, std::size_t threads = 1)
-      : phase_([] { return std::make_unique<CpuBackend>(); }, cellSize, threads) {}
+  explicit CpuMethod(std::optional<std::size_t> cellSize, std::size_t threads = 1,
+                     PartitionKind partition = PartitionKind::KdTree)
+      : phase_([] { return std::make_unique<CpuBackend>(); }, cellSize, threads, 1, partition) {}
   void update(std::span<const Aabb> boxes) override { phase_.findPairs(boxes, pairs_); }
   void pairs(std::vector<Pair>& out) override { out = pairs_; }
 
@@ -89,12 +91,14 @@ class CpuMethod final : public TimedMethod {
   std::vector<Pair> pairs_;
 };
 
-/// "accelerator k-d C" per cell size (none = no tree, all pairs: skipped above `maxAllPairsTests`).
+/// "accelerator k-d C" per cell size (none = no tree, all pairs: skipped above `maxAllPairsTests`);
+/// with the grid partition "accelerator grid C" (none = the same all pairs as k-d none: left out).
 std::vector<MethodSpec> acceleratorMethods(std::shared_ptr<const DeviceConfig> device,
                                            const std::vector<std::optional<std::size_t>>& cellSizes,
-                                           double maxAllPairsTests);
-/// "cpu k-d C" per cell size, with the same skip rule.
-std::vector<MethodSpec> cpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, double maxAllPairsTests);
+                                           double maxAllPairsTests, PartitionKind partition = PartitionKind::KdTree);
+/// "cpu k-d C" (or "cpu grid C") per cell size, with the same rules.
+std::vector<MethodSpec> cpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, double maxAllPairsTests,
+                                   PartitionKind partition = PartitionKind::KdTree);
 /// "cpu k-d C, T threads" per cell size with a tree.
 std::vector<MethodSpec> threadedCpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, std::size_t threads);
 

@@ -55,7 +55,7 @@ struct Entry {
   std::unique_ptr<TimedMethod> method;
   std::optional<std::string> skipped;
   double setupSeconds = 0, updateSeconds = 0;
-  std::vector<double> frameSeconds, hostSeconds, deviceSeconds, transferSeconds;
+  std::vector<double> frameSeconds, hostSeconds, partitionSeconds, deviceSeconds, transferSeconds;
   std::vector<double> deviceCycles, loadCycles, cycles, runs, batches, boxesSent;
   std::vector<double> pipelinedSeconds;           // modelled overlap of the same frames
   std::shared_ptr<const FrameTimeline> timeline;  // the last timed frame's, for the plot
@@ -97,10 +97,16 @@ std::vector<MethodSpec> standardLineUp(const LineUpConfig& config) {
   std::vector<MethodSpec> specs = bulletMethods(config.maxAllPairsTests);
   for (auto&& group : {fclMethods(config.maxSweepTests), cgalMethods(), odeMethods(config.maxSweepTests)})
     for (auto& s : group) specs.push_back(s);
-  if (config.device)
+  const std::vector<std::optional<std::size_t>> gridCells(config.gridCellSizes.begin(), config.gridCellSizes.end());
+  if (config.device) {
     for (auto& s : acceleratorMethods(config.device, config.cellSizes, config.maxAllPairsTests))
       specs.push_back(std::move(s));
+    for (auto& s : acceleratorMethods(config.device, gridCells, config.maxAllPairsTests, PartitionKind::UniformGrid))
+      specs.push_back(std::move(s));
+  }
   for (auto& s : cpuMethods(config.cellSizes, config.maxAllPairsTests)) specs.push_back(std::move(s));
+  for (auto& s : cpuMethods(gridCells, config.maxAllPairsTests, PartitionKind::UniformGrid))
+    specs.push_back(std::move(s));
   if (config.cpuThreads > 1)
     for (auto& s : threadedCpuMethods(config.cellSizes, config.cpuThreads)) specs.push_back(std::move(s));
   return specs;
@@ -109,7 +115,7 @@ std::vector<MethodSpec> standardLineUp(const LineUpConfig& config) {
 nlohmann::json describe(const LineUpConfig& config) {
   nlohmann::json cells = nlohmann::json::array();
   for (const auto& c : config.cellSizes) cells.push_back(cellName(c));
-  nlohmann::json j = {{"cell_sizes", cells}, {"max_all_pairs_tests_per_frame", config.maxAllPairsTests},
+  nlohmann::json j = {{"cell_sizes", cells}, {"grid_cell_sizes", config.gridCellSizes}, {"max_all_pairs_tests_per_frame", config.maxAllPairsTests},
                       {"max_sweep_tests", config.maxSweepTests}};
   if (const auto& d = config.device) {
     j["accelerator_backend"] = d->backend;
@@ -161,8 +167,8 @@ nlohmann::json Benchmark::run() {
                     {"libraries",
                      {"Bullet 3.24", "FCL 0.7.0", "CGAL 5.5.1", "ODE 0.16.2 (double precision)"}}};
   out["notes"] = {
-      {"measured", "Bullet and peer broad phases, cpu backend, accelerator host part (float-to-key conversion, k-d "
-                   "tree, packing, remapping and filtering pairs)"},
+      {"measured", "Bullet and peer broad phases, cpu backend, accelerator host part (float-to-key conversion, "
+                   "partition (k-d tree or grid), packing, remapping and filtering pairs)"},
       {"modelled", "accelerator device part (device cycles, loads included, / clock) and transfer part (link model)"},
       {"threads", "every method runs on one thread, but the rows 'cpu k-d C, T threads' (the cpu backend's cells "
                   "shared out among T threads)"}};
@@ -194,7 +200,7 @@ nlohmann::json timelineJson(const std::vector<Entry>& entries, std::size_t objec
           {"batches", t.device.size()},
           {"frame_ms", t.frameSeconds * 1e3},
           {"serial_ms", best->timelineSerialSeconds * 1e3},
-          {"what", "one frame: host work measured (producer = keys, tree, packing; decoder = decoding and filtering), "
+          {"what", "one frame: host work measured (producer = keys, partition, packing; decoder = decoding and filtering), "
                    "scheduled on two host threads by the model; link and device modelled"},
           {"lanes", {{"produce", lane(t.produce)}, {"link", lane(t.link)}, {"device", lane(t.device)},
                      {"decode", lane(t.decode)}}}};
@@ -320,6 +326,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
       e.frameSeconds.push_back(ft.seconds);
       if (const auto& p = ft.parts) {
         e.hostSeconds.push_back(p->hostSeconds);
+        e.partitionSeconds.push_back(p->partitionSeconds);
         e.deviceSeconds.push_back(p->deviceSeconds);
         e.transferSeconds.push_back(p->transferSeconds);
         e.deviceCycles.push_back(static_cast<double>(p->stats.deviceCycles()));
@@ -380,6 +387,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
     j["kind"] = kindName(e.spec->kind);
     j["library"] = e.spec->library;
     j["cell_size"] = e.spec->cellSize ? nlohmann::json(*e.spec->cellSize) : nlohmann::json("none");
+    if (!e.spec->partition.empty()) j["partition"] = e.spec->partition;
     if (e.skipped) {
       j["skipped"] = *e.skipped;
       j["frame_ms"] = nullptr;
@@ -397,6 +405,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
     j["update_s_total"] = e.updateSeconds;
     if (!e.hostSeconds.empty()) {
       j["host_ms_measured"] = summary(e.hostSeconds, 1e3);
+      j["host_partition_ms_measured"] = summary(e.partitionSeconds, 1e3);
       j["device_ms_modelled"] = summary(e.deviceSeconds, 1e3);
       j["transfer_ms_modelled"] = summary(e.transferSeconds, 1e3);
       j["device_cycles"] = summary(e.deviceCycles, 1);

@@ -38,7 +38,7 @@ struct BroadPhase::Worker {
   // list grows (and moves) while the batch fills.
   struct PendingCell {
     std::size_t begin = 0, count = 0;
-    KdTree::Leaf region{};
+    Cell region{};
     bool hasRegion = false;
     std::size_t splitAt = 0;
     int keep = 0;
@@ -49,22 +49,22 @@ struct BroadPhase::Worker {
   std::vector<std::span<const KeyBox>> cellSpans;
   std::vector<std::size_t> cellEnds;
 
-  // One device cell: a tree cell or a chunk pair. `packed`: its boxes in item
-  // order when the caller has them (the tree's leaves, the whole scene), else
+  // One device cell: a partition cell or a chunk pair. `packed`: its boxes in item
+  // order when the caller has them (carried tree leaves, the whole scene), else
   // empty: they are gathered from `keys`.
   void submit(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-              const KdTree::Leaf* region, std::size_t splitAt, int keep);
+              const Cell* region, std::size_t splitAt, int keep);
   void runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-              const KdTree::Leaf* region, std::size_t splitAt, int keep);
+              const Cell* region, std::size_t splitAt, int keep);
   void flush();  // hands the pending batch over, if any
   // One hand-over to the backend (`run` fills the record's counters), timed
   // and recorded for the pipeline model, then `decode` of its pairs.
   template <typename Run, typename Decode>
   void handOver(Run&& run, Decode&& decode);
   void keepPairs(std::span<const Pair> pairs, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-                 const KdTree::Leaf* region, std::size_t splitAt, int keep);
+                 const Cell* region, std::size_t splitAt, int keep);
   void processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-                   const KdTree::Leaf* region, std::size_t capacity);
+                   const Cell* region, std::size_t capacity);
 };
 
 /// The threads of a multi-threaded BroadPhase: an arena of its own, so the
@@ -81,8 +81,10 @@ class BroadPhase::Pool {
   tbb::task_arena arena_;
 };
 
-BroadPhase::BroadPhase(Backend& backend, std::optional<std::size_t> cellSize, std::size_t cellsPerBatch)
-    : cellSize_(cellSize), cellsPerBatch_(cellsPerBatch), capacity_(backend.capacity()) {
+BroadPhase::BroadPhase(Backend& backend, std::optional<std::size_t> cellSize, std::size_t cellsPerBatch,
+                       PartitionKind partition)
+    : cellSize_(cellSize), cellsPerBatch_(cellsPerBatch), capacity_(backend.capacity()),
+      partition_(makePartition(partition)) {
   auto w = std::make_unique<Worker>();
   w->backend = &backend;
   workers_.push_back(std::move(w));
@@ -90,8 +92,8 @@ BroadPhase::BroadPhase(Backend& backend, std::optional<std::size_t> cellSize, st
 }
 
 BroadPhase::BroadPhase(const BackendFactory& makeBackend, std::optional<std::size_t> cellSize, std::size_t threads,
-                       std::size_t cellsPerBatch)
-    : cellSize_(cellSize), cellsPerBatch_(cellsPerBatch) {
+                       std::size_t cellsPerBatch, PartitionKind partition)
+    : cellSize_(cellSize), cellsPerBatch_(cellsPerBatch), partition_(makePartition(partition)) {
   if (threads < 1) throw std::invalid_argument("broad phase: at least one thread");
   for (std::size_t t = 0; t < threads; ++t) {
     auto w = std::make_unique<Worker>();
@@ -147,17 +149,17 @@ void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out)
     streamCellsToThreads(keys);
   }
   finishCells(out);
-  times_.totalSeconds = times_.treeSeconds + times_.cellsSeconds;
+  times_.totalSeconds = times_.partitionSeconds + times_.cellsSeconds;
 }
 
-// Each cell goes to the backend as soon as the tree has made it, so the
-// first run is ready long before the tree is finished.
+// Each cell goes to the backend as soon as the partition has made it (with
+// the tree, the first run is ready long before the tree is finished).
 void BroadPhase::streamCells(std::span<const KeyBox> keys) {
   const auto t0 = Clock::now();
   Worker& w = *workers_.front();
   double inCells = 0;
-  tree_.build(keys, *cellSize_, [&](const KdTree::Leaf& leaf, std::span<const std::uint32_t> items,
-                                    std::span<const KeyBox> packed) {
+  partition_->build(keys, *cellSize_, [&](const Cell& leaf, std::span<const std::uint32_t> items,
+                                          std::span<const KeyBox> packed) {
     const auto c0 = Clock::now();
     w.processCell(keys, items, packed, &leaf, capacity_);
     inCells += seconds(c0, Clock::now());
@@ -166,21 +168,21 @@ void BroadPhase::streamCells(std::span<const KeyBox> keys) {
   w.flush();  // the last, partly filled batch
   inCells += seconds(f0, Clock::now());
   times_.cellsSeconds = inCells;
-  times_.treeSeconds = seconds(t0, Clock::now()) - inCells;
+  times_.partitionSeconds = seconds(t0, Clock::now()) - inCells;
 }
 
-// The calling thread builds the tree and hands each cell to the pool as a
-// task while it goes on; the other threads process cells meanwhile, and the
-// builder joins them when the tree is done. A task gets its own copy of the
-// cell's items and boxes: the tree's storage changes as the build goes on.
+// The calling thread builds the partition and hands each cell to the pool as
+// a task while it goes on; the other threads process cells meanwhile, and the
+// builder joins them when the partition is done. A task gets its own copy of
+// the cell's items and boxes: the tree's storage changes as the build goes on.
 void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys) {
   const auto t0 = Clock::now();
   Clock::time_point built;
   pool_->run([&] {
     tbb::task_group tasks;
     std::size_t used = 0;
-    tree_.build(keys, *cellSize_, [&](const KdTree::Leaf& leaf, std::span<const std::uint32_t> items,
-                                      std::span<const KeyBox> packed) {
+    partition_->build(keys, *cellSize_, [&](const Cell& leaf, std::span<const std::uint32_t> items,
+                                            std::span<const KeyBox> packed) {
       if (items.size() < 2) return;  // no pair
       if (used == cellCopies_.size()) cellCopies_.emplace_back();  // a deque: earlier copies stay put
       CellCopy& copy = cellCopies_[used++];
@@ -198,7 +200,7 @@ void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys) {
     // this thread may use every worker's backend.
     for (auto& w : workers_) w->flush();
   });
-  times_.treeSeconds = seconds(t0, built);
+  times_.partitionSeconds = seconds(t0, built);
   times_.cellsSeconds = seconds(built, Clock::now());
 }
 
@@ -230,7 +232,7 @@ void BroadPhase::finishCells(std::vector<Pair>& out) {
 // pairs, and each chunk's inside pairs are kept from exactly one run: chunk
 // p from run (p, p+1), the last chunk from run (k-2, k-1).
 void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
-                                     std::span<const KeyBox> packed, const KdTree::Leaf* region,
+                                     std::span<const KeyBox> packed, const Cell* region,
                                      std::size_t capacity) {
   if (items.size() < 2) return;
   if (items.size() <= capacity) {
@@ -255,7 +257,7 @@ void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<con
 }
 
 void BroadPhase::Worker::submit(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
-                                std::span<const KeyBox> packed, const KdTree::Leaf* region, std::size_t splitAt,
+                                std::span<const KeyBox> packed, const Cell* region, std::size_t splitAt,
                                 int keep) {
   if (cellsPerBatch <= 1) {
     runNow(keys, items, packed, region, splitAt, keep);
@@ -306,7 +308,7 @@ void BroadPhase::Worker::flush() {
 }
 
 void BroadPhase::Worker::runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
-                                std::span<const KeyBox> packed, const KdTree::Leaf* region, std::size_t splitAt,
+                                std::span<const KeyBox> packed, const Cell* region, std::size_t splitAt,
                                 int keep) {
   if (packed.empty()) {
     gathered.resize(items.size());
@@ -336,7 +338,7 @@ void BroadPhase::Worker::handOver(Run&& run, Decode&& decode) {
 // asks for (a chunk pair's cross pairs, or the inside pairs of one chunk),
 // and only those whose reference point lies in the cell's region.
 void BroadPhase::Worker::keepPairs(std::span<const Pair> pairs, std::span<const std::uint32_t> items,
-                                   std::span<const KeyBox> packed, const KdTree::Leaf* region, std::size_t splitAt,
+                                   std::span<const KeyBox> packed, const Cell* region, std::size_t splitAt,
                                    int keep) {
   for (const auto& [a, b] : pairs) {
     const bool firstA = a < splitAt, firstB = b < splitAt;

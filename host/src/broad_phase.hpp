@@ -1,5 +1,5 @@
 #pragma once
-// A whole-scene broad phase: keys, optional k-d tree, chunking, backend runs.
+// A whole-scene broad phase: keys, optional partition (k-d tree or grid), chunking, backend runs.
 
 #include <chrono>
 #include <deque>
@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "backend.hpp"
-#include "kd_tree.hpp"
+#include "partition.hpp"
 #include "timeline.hpp"
 #include "types.hpp"
 
@@ -19,7 +19,7 @@ namespace bpaccel {
 /// Host time of one findPairs call, by part (measured with a steady clock).
 struct HostTimes {
   double convertSeconds = 0;  // float to key conversion and validation
-  double treeSeconds = 0;     // k-d tree build
+  double partitionSeconds = 0;  // partition build (k-d tree or grid), without the cells' processing
   double cellsSeconds = 0;    // packing, backend runs, decoding and filtering
   double backendSeconds = 0;  // inside Backend::run (simulating the device, or the cpu test itself),
                               // summed over the worker threads
@@ -31,8 +31,11 @@ struct HostTimes {
 /// covered in chunks of capacity/2 boxes: every two chunks run together, and
 /// each pair is kept from exactly one of those runs.
 ///
-/// The cells go to the backend as the k-d tree makes them, while it goes on.
-/// With several threads, the calling thread builds the tree and the cells are
+/// The scene is partitioned into cells by a k-d tree (the default) or a
+/// uniform grid (PartitionKind). The cells go to the backend as the
+/// partition makes them: the tree hands each over while it goes on, the
+/// grid all of them after its two passes.
+/// With several threads, the calling thread builds the partition and the cells are
 /// shared out among workers as tasks, each worker with a backend of its own
 /// from the factory (backends keep scratch state and are not shared between
 /// threads).
@@ -42,16 +45,17 @@ struct HostTimes {
 /// into the batch it is filling and hands it over when it holds that many
 /// cells, and at the end of the frame. One batch is one hand-over to the
 /// device (one link latency). With 1, each cell is handed over on its own,
-/// straight from the tree's storage.
+/// straight from the partition's storage.
 class BroadPhase {
  public:
   using BackendFactory = std::function<std::unique_ptr<Backend>()>;
 
   /// One thread, on `backend`.
-  BroadPhase(Backend& backend, std::optional<std::size_t> cellSize, std::size_t cellsPerBatch = 1);
+  BroadPhase(Backend& backend, std::optional<std::size_t> cellSize, std::size_t cellsPerBatch = 1,
+             PartitionKind partition = PartitionKind::KdTree);
   /// `threads` workers (at least 1), each with its own backend.
   BroadPhase(const BackendFactory& makeBackend, std::optional<std::size_t> cellSize, std::size_t threads,
-             std::size_t cellsPerBatch = 1);
+             std::size_t cellsPerBatch = 1, PartitionKind partition = PartitionKind::KdTree);
   ~BroadPhase();
   BroadPhase(const BroadPhase&) = delete;
   BroadPhase& operator=(const BroadPhase&) = delete;
@@ -63,7 +67,8 @@ class BroadPhase {
 
   const RunStats& stats() const { return stats_; }
   const HostTimes& times() const { return times_; }
-  const KdTree& tree() const { return tree_; }
+  /// The last call's cells (with a cell size).
+  const Partition& partition() const { return *partition_; }
   std::size_t threads() const { return workers_.size(); }
   std::size_t cellsPerBatch() const { return cellsPerBatch_; }
   /// The last call's hand-overs to the backend (batches, or single runs) in
@@ -75,8 +80,8 @@ class BroadPhase {
  private:
   struct Worker;
   class Pool;
-  void streamCells(std::span<const KeyBox> keys);           // one thread: tree and cells interleaved
-  void streamCellsToThreads(std::span<const KeyBox> keys);  // the pool: cells as tasks while the tree goes on
+  void streamCells(std::span<const KeyBox> keys);           // one thread: partition and cells interleaved
+  void streamCellsToThreads(std::span<const KeyBox> keys);  // the pool: cells as tasks while the partition goes on
   void startCells(std::chrono::steady_clock::time_point frameStart);  // clears the workers' results
   void finishCells(std::vector<Pair>& out);                            // gathers them
   void check() const;
@@ -87,7 +92,7 @@ class BroadPhase {
   std::optional<std::size_t> cellSize_;
   std::size_t cellsPerBatch_;
   std::size_t capacity_;
-  KdTree tree_;
+  std::unique_ptr<Partition> partition_;
   std::vector<KeyBox> keys_;
   std::vector<std::uint32_t> identity_;  // 0..n-1: the scene as one cell
   struct CellCopy {

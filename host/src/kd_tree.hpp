@@ -3,11 +3,10 @@
 
 #include <array>
 #include <cstdint>
-#include <functional>
 #include <span>
 #include <vector>
 
-#include "types.hpp"
+#include "partition.hpp"
 
 namespace bpaccel {
 
@@ -21,24 +20,12 @@ namespace bpaccel {
 /// [lo, hi). A box goes to a child whose region it touches (so a box that
 /// straddles a split plane goes to both), which puts every box that contains
 /// a point p into the one leaf whose region contains p.
-class KdTree {
+class KdTree final : public Partition {
  public:
-  struct Leaf {
-    std::uint64_t begin;               // offset of the first item in items()
-    std::uint32_t count;               // number of boxes in the cell
-    std::array<std::uint64_t, 3> lo;   // region, inclusive
-    std::array<std::uint64_t, 3> hi;   // region, exclusive (up to 2^32)
-    bool contains(const std::array<std::uint32_t, 3>& p) const {
-      return lo[0] <= p[0] && p[0] < hi[0] && lo[1] <= p[1] && p[1] < hi[1] && lo[2] <= p[2] && p[2] < hi[2];
-    }
-  };
-
-  /// Called with each leaf as soon as it is final, while the build goes on,
-  /// with its items and, when the build carries boxes (see Layout), their
-  /// boxes in the same order (packed; else empty). All three are valid during
-  /// the call only.
-  using LeafSink =
-      std::function<void(const Leaf&, std::span<const std::uint32_t> items, std::span<const KeyBox> packed)>;
+  using Leaf = Cell;
+  /// Gets each leaf as soon as it is final, while the build goes on; its
+  /// boxes come packed when the build carries them (see Layout).
+  using LeafSink = CellSink;
 
   /// Splits until a cell holds at most `cellSize` boxes, or until no split
   /// helps (every plane is straddled by too many boxes): such a cell stays
@@ -55,17 +42,22 @@ class KdTree {
   /// 153. Auto carries above kCarryAbove boxes. Both give the same leaves.
   enum class Layout { Auto, Carried, Gathered };
   static constexpr std::size_t kCarryAbove = 1 << 18;  // 6.3 MB of boxes
-  void build(std::span<const KeyBox> boxes, std::size_t cellSize, const LeafSink& onLeaf = {},
-             Layout layout = Layout::Auto);
+  void build(std::span<const KeyBox> boxes, std::size_t cellSize, const LeafSink& onLeaf, Layout layout);
+  void build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell) override {
+    build(boxes, cellSize, onCell, Layout::Auto);
+  }
+  std::string_view name() const override { return "k-d"; }
 
-  const std::vector<Leaf>& leaves() const { return leaves_; }
+  const std::vector<Leaf>& cells() const override { return leaves_; }
   /// Item entries the tree's buffers hold (their capacity): what its memory
   /// grows with. Each work and scratch entry also carries its box (24 bytes).
   std::size_t storedItems() const {
     return leafItems_.capacity() + work_.capacity() + left_.capacity() + right_.capacity();
   }
   /// Box indices of a leaf.
-  std::span<const std::uint32_t> items(const Leaf& leaf) const { return {leafItems_.data() + leaf.begin, leaf.count}; }
+  std::span<const std::uint32_t> items(const Leaf& leaf) const override {
+    return {leafItems_.data() + leaf.begin, leaf.count};
+  }
 
  private:
   // A node waiting to be split: its items are work_[begin, begin + count),
@@ -88,12 +80,5 @@ class KdTree {
   std::vector<Task> stack_;
   std::vector<Leaf> leaves_;
 };
-
-/// The reference point of an overlapping pair: the low corner of the two
-/// boxes' intersection. It lies in both boxes, so exactly one leaf holds it,
-/// and that leaf holds both boxes: a pair is reported only there.
-inline std::array<std::uint32_t, 3> referencePoint(const KeyBox& a, const KeyBox& b) {
-  return {std::max(a.min[0], b.min[0]), std::max(a.min[1], b.min[1]), std::max(a.min[2], b.min[2])};
-}
 
 }  // namespace bpaccel

@@ -29,6 +29,7 @@ bool mustBeExact(MethodKind kind);
 /// Parts of a frame whose device and link are modelled, not measured.
 struct ModelledParts {
   double hostSeconds = 0;      // measured on this machine
+  double partitionSeconds = 0; // measured: the part of hostSeconds that built the partition (k-d tree or grid)
   double deviceSeconds = 0;    // modelled: device cycles / clock
   double transferSeconds = 0;  // modelled: link model
   RunStats stats;              // the device's counters for the frame
@@ -69,7 +70,8 @@ struct MethodSpec {
   std::string name;
   MethodKind kind = MethodKind::Peer;
   std::string library;                  // e.g. "Bullet 3.24": the table's blocks per library
-  std::optional<std::size_t> cellSize;  // accelerator and cpu: the k-d tree's cell size
+  std::optional<std::size_t> cellSize;  // accelerator and cpu: the partition's cell size
+  std::string partition;                // accelerator and cpu: "k-d" or "grid"; else empty
   /// Why the method cannot run on this scene; nullopt when it can. May be empty.
   std::function<std::optional<std::string>(const SceneStart&)> skipReason;
   std::function<std::unique_ptr<TimedMethod>(const SceneStart&)> make;

@@ -44,6 +44,7 @@ std::shared_ptr<DeviceConfig> rtlDevice() {
 LineUpConfig tinyLineUp() {
   LineUpConfig l;
   l.cellSizes = {std::nullopt, 4, 16};
+  l.gridCellSizes = {16};
   l.device = rtlDevice();
   return l;
 }
@@ -168,8 +169,12 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
   for (const auto& row : j["rows"]) {
     EXPECT_TRUE(row.contains("exact_pairs_per_frame_mean"));
     EXPECT_FALSE(row["fastest_baseline"].is_null());
-    // Bullet 3, FCL 3, CGAL 1, ODE 2, then accelerator and cpu per cell size.
-    ASSERT_EQ(row["methods"].size(), 3u + 3u + 1u + 2u + 3u + 3u);
+    // Bullet 3, FCL 3, CGAL 1, ODE 2, then accelerator and cpu per cell size, k-d and grid.
+    ASSERT_EQ(row["methods"].size(), 3u + 3u + 1u + 2u + (3u + 1u) + (3u + 1u));
+    std::set<std::string> gridRows;
+    for (const auto& m : row["methods"])
+      if (m.value("partition", "") == "grid") gridRows.insert(m["name"]);
+    EXPECT_EQ(gridRows, (std::set<std::string>{"accelerator grid 16", "cpu grid 16"}));
     for (const auto& m : row["methods"]) {
       kinds.insert(m["kind"]);
       libraries.insert(m["library"]);
@@ -179,7 +184,8 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
       if (m["kind"] == "accelerator" || m["kind"] == "cpu") EXPECT_EQ(m["missing_pairs"], 0) << m["name"];
       EXPECT_EQ(m["acceleration_over"].size(), 9u);
       if (m["kind"] == "accelerator")
-        for (const char* part : {"host_ms_measured", "device_ms_modelled", "transfer_ms_modelled", "device_cycles",
+        for (const char* part : {"host_ms_measured", "host_partition_ms_measured", "device_ms_modelled",
+                                 "transfer_ms_modelled", "device_cycles",
                                  "load_cycles", "runs", "batches", "serial_frame_ms", "pipelined_frame_ms_modelled"})
           EXPECT_TRUE(m.contains(part)) << part;
       if (m["kind"] == "accelerator") {
@@ -188,6 +194,13 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
                   m["device_ms_modelled"]["min"].get<double>())
             << m["name"];
         EXPECT_EQ(m["serial_frame_ms"], m["frame_ms"]) << m["name"];
+        // The partition is a part of the host's work, and only rows with a cell size build one.
+        const double partition = m["host_partition_ms_measured"]["median"].get<double>();
+        EXPECT_LE(partition, m["host_ms_measured"]["median"].get<double>()) << m["name"];
+        if (m["cell_size"] == "none")
+          EXPECT_EQ(partition, 0) << m["name"];
+        else
+          EXPECT_GT(partition, 0) << m["name"];
       }
     }
     // The timeline of the row's best accelerator method: one device span per hand-over.

@@ -12,6 +12,7 @@
 #include "broad_phase.hpp"
 #include "bpaccel_params.h"
 #include "exact_pairs.hpp"
+#include "kd_tree.hpp"
 #include "keys.hpp"
 #include "scenes.hpp"
 
@@ -63,7 +64,7 @@ TEST(BroadPhase, DegenerateScenesFallBackToChunkedLeaves) {
   BroadPhase bp(small, 16);
   std::vector<Pair> pairs;
   bp.findPairs(same, pairs);
-  EXPECT_EQ(bp.tree().leaves().size(), 1u);
+  EXPECT_EQ(bp.partition().cells().size(), 1u);
   EXPECT_EQ(pairs.size(), 300u * 299u / 2u);
   EXPECT_EQ(sorted(pairs), bruteForce(same));
   EXPECT_GT(bp.stats().runs, 1u);  // chunked
@@ -76,9 +77,9 @@ TEST(KdTree, LeavesRespectTheCellSizeWhenSplitsExistAndPartitionSpace) {
   toKeys(boxes, keys);
   KdTree tree;
   for (std::size_t cell : {8u, 32u, 128u}) {
-    tree.build(keys, cell);
+    tree.build(keys, cell, {});
     std::size_t maxLeaf = 0, total = 0;
-    for (const auto& leaf : tree.leaves()) {
+    for (const auto& leaf : tree.cells()) {
       maxLeaf = std::max<std::size_t>(maxLeaf, leaf.count);
       total += leaf.count;
       // Every box of a leaf touches the leaf's region.
@@ -96,7 +97,7 @@ TEST(KdTree, LeavesRespectTheCellSizeWhenSplitsExistAndPartitionSpace) {
       const std::array<std::uint32_t, 3> p{static_cast<std::uint32_t>(rng()), static_cast<std::uint32_t>(rng()),
                                            static_cast<std::uint32_t>(rng())};
       int holders = 0;
-      for (const auto& leaf : tree.leaves()) holders += leaf.contains(p);
+      for (const auto& leaf : tree.cells()) holders += leaf.contains(p);
       EXPECT_EQ(holders, 1);
     }
   }
@@ -115,8 +116,8 @@ TEST(KdTree, MemoryStaysLinearInTheObjectsHoweverDeepTheTree) {
   std::vector<KeyBox> keys;
   toKeys(boxes, keys);
   KdTree tree;
-  tree.build(keys, 2);
-  ASSERT_GT(tree.leaves().size(), 8000u);  // the tree really is deep
+  tree.build(keys, 2, {});
+  ASSERT_GT(tree.cells().size(), 8000u);  // the tree really is deep
   EXPECT_LE(tree.storedItems(), 8 * keys.size());
 }
 
@@ -131,8 +132,8 @@ TEST(KdTree, ReportsAPairInSeveralLeavesOnlyOnce) {
   std::vector<Pair> pairs;
   bp.findPairs(boxes, pairs);
   std::size_t sharing = 0;
-  for (const auto& leaf : bp.tree().leaves()) {
-    const auto items = bp.tree().items(leaf);
+  for (const auto& leaf : bp.partition().cells()) {
+    const auto items = bp.partition().items(leaf);
     const bool a = std::find(items.begin(), items.end(), 400u) != items.end();
     const bool b = std::find(items.begin(), items.end(), 401u) != items.end();
     sharing += a && b;
@@ -300,7 +301,7 @@ class LeafCountingBackend final : public Backend {
   std::string name() const override { return inner_.name(); }
   std::size_t capacity() const override { return inner_.capacity(); }
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override {
-    leavesAtRun.push_back(phase_->tree().leaves().size());
+    leavesAtRun.push_back(phase_->partition().cells().size());
     inner_.run(boxes, out, stats);
   }
   std::vector<std::size_t> leavesAtRun;
@@ -321,7 +322,7 @@ TEST(BroadPhase, CellsReachTheBackendWhileTheTreeIsStillBeingBuilt) {
   const std::vector<Aabb> boxes = scatteredBoxes(2000, 9, -40, 40, 0, 2);
   std::vector<Pair> pairs;
   bp.findPairs(boxes, pairs);
-  const std::size_t leaves = bp.tree().leaves().size();
+  const std::size_t leaves = bp.partition().cells().size();
   ASSERT_GT(leaves, 50u);
   ASSERT_FALSE(counting.leavesAtRun.empty());
   // The first cell runs when the tree has made one leaf, not all of them; and
@@ -335,9 +336,9 @@ TEST(BroadPhase, CellsReachTheBackendWhileTheTreeIsStillBeingBuilt) {
   std::vector<Pair> scratch;
   std::vector<KeyBox> keys;
   toKeys(boxes, keys);
-  for (const auto& leaf : bp.tree().leaves()) {
+  for (const auto& leaf : bp.partition().cells()) {
     std::vector<KeyBox> cell;
-    for (auto i : bp.tree().items(leaf)) cell.push_back(keys[i]);
+    for (auto i : bp.partition().items(leaf)) cell.push_back(keys[i]);
     if (cell.size() >= 2) again.run(cell, scratch, sum);
   }
   EXPECT_EQ(sum.cycles, bp.stats().cycles);

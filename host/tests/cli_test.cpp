@@ -64,6 +64,19 @@ TEST(Cli, BatchesOfCellsGiveTheSamePairsAsSingleRuns) {
   EXPECT_NE(runCli(kScene, "--cells-per-batch 0").exitCode, 0);
 }
 
+TEST(Cli, TheGridPartitionGivesTheSamePairsAndNamesItselfInTheStats) {
+  for (const char* backend : {"rtl", "model", "cpu"})
+    for (const char* cell : {"1", "2", "16"}) {
+      const auto r = runCli(kScene, std::string("--backend ") + backend + " --cell-size " + cell +
+                                        " --partition grid --repeat 3 --stats");
+      EXPECT_EQ(r.exitCode, 0) << r.err;
+      EXPECT_EQ(r.out, "0 1\n0 3\n") << backend << " " << cell;
+      EXPECT_NE(r.err.find("partition grid"), std::string::npos) << r.err;
+      EXPECT_NE(r.err.find("(median of 3 frames)"), std::string::npos) << r.err;
+    }
+  EXPECT_NE(runCli(kScene, "--partition octree").exitCode, 0);
+}
+
 TEST(Cli, StatsGoToStderr) {
   const auto r = runCli(kScene, "--backend rtl --stats");
   EXPECT_EQ(r.exitCode, 0);

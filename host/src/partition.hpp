@@ -1,0 +1,72 @@
+#pragma once
+// A partition of key space into cells, each with the boxes that touch it: what
+// BroadPhase hands to the backend cell by cell. Two kinds: the k-d tree
+// (kd_tree.hpp, any scene) and the uniform grid (uniform_grid.hpp, cheaper on
+// near-uniform scenes).
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "types.hpp"
+
+namespace bpaccel {
+
+/// One cell: a half-open region [lo, hi) of key space and its boxes. The
+/// cells of a partition cover key space without overlap, and every box is in
+/// every cell whose region it touches, so every point p lies in exactly one
+/// cell and that cell holds every box that contains p.
+struct Cell {
+  std::uint64_t begin;               // offset of the first item in Partition::items()
+  std::uint32_t count;               // number of boxes in the cell
+  std::array<std::uint64_t, 3> lo;   // region, inclusive
+  std::array<std::uint64_t, 3> hi;   // region, exclusive (up to 2^32)
+  bool contains(const std::array<std::uint32_t, 3>& p) const {
+    return lo[0] <= p[0] && p[0] < hi[0] && lo[1] <= p[1] && p[1] < hi[1] && lo[2] <= p[2] && p[2] < hi[2];
+  }
+};
+
+/// Called with each cell as soon as it is final, with its items and, when the
+/// partition has them, their boxes in the same order (packed; else empty).
+/// All three are valid during the call only.
+using CellSink = std::function<void(const Cell&, std::span<const std::uint32_t> items, std::span<const KeyBox> packed)>;
+
+/// Built anew every frame from the frame's boxes; storage is kept between builds.
+class Partition {
+ public:
+  virtual ~Partition() = default;
+  /// "k-d" or "grid": the method rows' and the CLI's name.
+  virtual std::string_view name() const = 0;
+  /// Partitions `boxes` into cells of about `cellSize` boxes (what "about"
+  /// means is each kind's own rule) and hands each cell to `onCell` (if any).
+  /// A cell may hold more than cellSize boxes; BroadPhase chunks cells
+  /// above the backend's capacity.
+  virtual void build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell) = 0;
+  /// The last build's cells, in the order they were handed over.
+  virtual const std::vector<Cell>& cells() const = 0;
+  /// Box indices of a cell of the last build.
+  virtual std::span<const std::uint32_t> items(const Cell& cell) const = 0;
+};
+
+enum class PartitionKind { KdTree, UniformGrid };
+
+std::unique_ptr<Partition> makePartition(PartitionKind kind);
+/// "k-d" or "grid".
+std::string_view partitionName(PartitionKind kind);
+/// "kd" or "grid" (the CLI's spelling); throws std::invalid_argument naming the text otherwise.
+PartitionKind parsePartitionKind(const std::string& text);
+
+/// The reference point of an overlapping pair: the low corner of the two
+/// boxes' intersection. It lies in both boxes, so exactly one cell holds it,
+/// and that cell holds both boxes: a pair is reported only there.
+inline std::array<std::uint32_t, 3> referencePoint(const KeyBox& a, const KeyBox& b) {
+  return {std::max(a.min[0], b.min[0]), std::max(a.min[1], b.min[1]), std::max(a.min[2], b.min[2])};
+}
+
+}  // namespace bpaccel
