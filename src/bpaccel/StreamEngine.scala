@@ -53,13 +53,14 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val n        = Reg(UInt(p.countWidth.W))
   val starting = RegInit(false.B)
   val issuing  = RegInit(false.B)
-  // Window shifts still needed at startup, as a thermometer (bit k: more
-  // than k), like `owes` below: the enables' look-ahead reads single bits.
-  val fillLeft = Reg(UInt((m + 1).W))
+  // Window shifts still needed at startup, as a thermometer like `owes`
+  // below (bit k: more than k+1 left; more than 0 is `filling`), so that the
+  // enables' look-ahead reads single bits.
+  val fillMoreThan1 = Reg(UInt(m.W))
   val primeLeft = Reg(UInt(log2Ceil(p.readLatency + 1).W)) // cycles until the first read reaches the entry
 
   // Registered flags only in front of the window's enables (192m flip-flops).
-  val filling = RegInit(false.B) // starting && fillLeft != 0
+  val filling = RegInit(false.B) // starting and window shifts still needed
   val issue   = issuing && advance
   val fill    = filling
 
@@ -219,9 +220,9 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   for (k <- 0 until m) when(aLoad(k)) { a(k) := aNext(k) }
   when(starting) {
     when(primeLeft =/= 0.U) { primeLeft := primeLeft - 1.U }
-    fillLeft    := fillLeft >> 1
-    fillingNext := fillLeft(1)
-    when(primeLeft <= 1.U && !fillLeft(1)) {
+    fillMoreThan1 := fillMoreThan1 >> 1
+    fillingNext   := fillMoreThan1(0)
+    when(primeLeft <= 1.U && !fillMoreThan1(0)) {
       startingNext := false.B
       issuingNext  := true.B
     }
@@ -254,8 +255,8 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     n         := count
     primeLeft := p.readLatency.U
     // The last box may shift in during this cycle.
-    fillLeft := (if (p.has(Fault.WindowFillFromCount)) VecInit((0 to m).map(k => count <= (m - k).U)).asUInt // m+1-count > k
-                 else owesAfterShift)
+    fillMoreThan1 := (if (p.has(Fault.WindowFillFromCount)) VecInit((0 until m).map(k => count < (m - k).U)).asUInt // m+1-count > k+1
+                      else owesAfterShift >> 1)
     base      := 0.U
     s         := 1.U
     left      := count - 2.U
