@@ -146,8 +146,10 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
     // Appended branch-free: the slot is overwritten unless the box straddles.
     straddlers[straddling] = static_cast<std::uint32_t>(i);
     ranges[straddling] = r;
-    straddling += static_cast<std::size_t>((r.first[0] != r.last[0]) | (r.first[1] != r.last[1]) |
-                                           (r.first[2] != r.last[2]));
+    // Bitwise on integers, not on bools: no branch, and no warning from clang.
+    straddling += static_cast<std::size_t>(static_cast<unsigned>(r.first[0] != r.last[0]) |
+                                           static_cast<unsigned>(r.first[1] != r.last[1]) |
+                                           static_cast<unsigned>(r.first[2] != r.last[2]));
   }
   straddling_ = straddling;
   // The straddlers' other cells, within the cap on entries.
