@@ -165,11 +165,12 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // that counting one down is a shift and the look-ahead of the window's
   // enables reads single bits instead of a subtraction (stream m = 64).
   val loadedBox  = Pipe(io.write)
-  val owes       = RegInit(((BigInt(1) << (m + 1)) - 1).U((m + 1).W))
+  val owesAll    = ((BigInt(1) << (m + 1)) - 1).U((m + 1).W) // m+1 shifts owed: a start
+  val owes       = RegInit(owesAll)
   val takesLoads = owes(0)
   val loadShift  = loadedBox.valid && takesLoads
   val owesAfterShift = Mux(loadShift, owes >> 1, owes) // at most m+1 boxes shift in
-  val owesNext       = Mux(io.clear, ((BigInt(1) << (m + 1)) - 1).U, owesAfterShift)
+  val owesNext       = Mux(io.clear, owesAll, owesAfterShift)
   owes := owesNext
   val takesLoadsNext = owesNext(0)
   val entry = Wire(new Entry)
