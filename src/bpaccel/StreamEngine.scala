@@ -66,12 +66,10 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   // The next values of the flags behind the wide enables (window, A block):
   // the enables are computed from them a cycle ahead, see `replicatedEnable`.
-  val startingNext     = WireDefault(starting)
-  val issuingNext      = WireDefault(issuing)
-  val fillingNext      = WireDefault(filling)
-  starting := startingNext
-  issuing  := issuingNext
-  filling  := fillingNext
+  // `*Carry`: the next value unless a run is launched in this cycle.
+  val startingCarry = WireDefault(starting)
+  val fillingCarry  = WireDefault(filling)
+  val issuingNext   = WireDefault(issuing)
 
   // ---- read side: the stream R from R[m] on, read ahead into a small queue ----
   // The memory and its output registers run freely (no enable, no
@@ -173,12 +171,32 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val owesNext       = Mux(io.clear, owesAll, owesAfterShift)
   owes := owesNext
   val takesLoadsNext = owesNext(0)
+  // A launched run fills the window while fewer than m+1 boxes shifted in
+  // (the last box may shift in during the launch's cycle).
+  val launchFills =
+    if (p.has(Fault.WindowFillFromCount)) io.prepare.bits <= m.U else owesAfterShift(0)
+  val startingNext = io.launch.valid || startingCarry
+  val fillingNext  = Mux(io.launch.valid, launchFills, fillingCarry)
+  starting := startingNext
+  issuing  := issuingNext
+  filling  := fillingNext
+  // The look-ahead of the enables takes every accepted start (`io.prepare`)
+  // for a launch, so that the start's decoded error checks stay out of it
+  // (stream m = 32's critical path ran from them into the window's enable
+  // copies). A start that does not launch therefore shifts the window and
+  // copies the A block once, in the next cycle: harmless, as the start
+  // emptied the loader, the next run's m+1 window shifts all come after that
+  // cycle (its first box reaches the window two cycles after the start at
+  // the earliest), and its startup copies the A block again.
+  val startingSoon = io.prepare.valid || startingCarry
+  val fillingSoon  = Mux(io.prepare.valid, launchFills, fillingCarry)
+  val unlaunchedStart = RegNext(io.prepare.valid && !io.launch.valid, false.B)
   val entry = Wire(new Entry)
   entry.box := Mux(loadedBox.valid, loadedBox.bits.box.asUInt, readQueue.io.deq.bits.box)
   entry.tag := Mux(loadedBox.valid, tagOf(loadedBox.bits.index), readQueue.io.deq.bits.tag)
   val windowShift = replicatedEnable(
     "windowShift",
-    next = (io.write.valid && takesLoadsNext) || fillingNext ||
+    next = (io.write.valid && takesLoadsNext) || fillingSoon ||
       (issuingNext && (io.room || p.has(Fault.LookaheadIgnoresRoom).B)),
     now = loadShift || fill || issue
   )
@@ -215,16 +233,16 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // The A block is copied from aNext through the startup and at each block change.
   val aLoad = replicatedEnable(
     "aLoad",
-    next = startingNext || (issuingNext && io.room && blockEndNext && hasNextBlockNext),
+    next = startingSoon || (issuingNext && io.room && blockEndNext && hasNextBlockNext),
     now = starting || (issue && blockEnd && hasNextBlock)
   )
   for (k <- 0 until m) when(aLoad(k)) { a(k) := aNext(k) }
   when(starting) {
     when(primeLeft =/= 0.U) { primeLeft := primeLeft - 1.U }
     fillMoreThan1 := fillMoreThan1 >> 1
-    fillingNext   := fillMoreThan1(0)
+    fillingCarry  := fillMoreThan1(0)
     when(primeLeft <= 1.U && !fillMoreThan1(0)) {
-      startingNext := false.B
+      startingCarry := false.B
       issuingNext  := true.B
     }
   }
@@ -275,11 +293,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     rBlockEnd     := !longBlock || count === (m + 2).U
     rHasNextBlock := count >= (m + 2).U // rBlockLeft = count-2 >= m
   }
-  when(io.launch.valid) {
-    startingNext := true.B
-    fillingNext  := (if (p.has(Fault.WindowFillFromCount)) io.launch.bits <= m.U else owesAfterShift(0))
-    readCredits  := readDepth.U
-  }
+  when(io.launch.valid) { readCredits := readDepth.U }
 
   // ---- comparators: registered compare, then registered AND ----
   val remaining = n - s // >= 1 while issuing
@@ -331,7 +345,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   private def replicatedEnable(name: String, next: Bool, now: Bool): Seq[Bool] =
     Seq.tabulate(m) { k =>
       val copy = RegNext(next, false.B).suggestName(s"${name}_replica$k")
-      assert(copy === now, s"the look-ahead of $name is wrong")
+      assert(copy === now || unlaunchedStart, s"the look-ahead of $name is wrong")
       copy
     }
 
