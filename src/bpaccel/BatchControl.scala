@@ -51,13 +51,19 @@ class BatchControl(p: AccelParams) extends Module {
   // Outside a batch a count is taken only when no run is busy and no start is
   // offered. With batchCells = 1 the head is the whole queue: no count is
   // taken while it is in use.
-  val takesCount = (active && (p.batchCells > 1).B) || (!io.runBusy && !io.hostStart)
+  val takesFirstCount = !io.runBusy && !io.hostStart
+  val takesCount = (active && (p.batchCells > 1).B) || takesFirstCount
   val tailIn     = Wire(Decoupled(UInt(p.countWidth.W)))
   tailIn.valid   := io.cells.valid && takesCount
   tailIn.bits    := io.cells.bits
   io.cells.ready := tailIn.ready && takesCount
   val tail = Queue(tailIn, p.batchCells - 1, flow = true) // no entries: a wire
-  io.begin          := io.cells.fire && !active
+  // Outside a batch the tail is empty and a count flows straight to the head,
+  // so the first count is taken without asking the tail queue: its pointers
+  // were the start of stream m = 64's critical path (through `begin` and the
+  // loader's clear to the loaded count).
+  assert(active || tailIn.ready, "the batch front end's tail queue held a count outside a batch")
+  io.begin := io.cells.valid && !active && takesFirstCount
 
   val loading = active && !running
   io.loadReady   := wantsBox
