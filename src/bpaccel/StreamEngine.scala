@@ -230,6 +230,16 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val hasNextBlockNext = WireDefault(hasNextBlock)
   blockEnd     := blockEndNext
   hasNextBlock := hasNextBlockNext
+  // Their next values, in turn, from flags kept a step ahead of the counters,
+  // so that no comparison sits in the enables' look-ahead either (the path
+  // advance -> issue -> blockEndNext -> aLoad's copies, stream m = 32).
+  val leftIsOne          = Reg(Bool()) // left == 1
+  val blockLeftIsM       = Reg(Bool()) // blockLeft == m
+  val blockLeftAtLeast2m = Reg(Bool()) // blockLeft >= 2m
+  when(starting || issuing) {
+    assert(leftIsOne === (left === 1.U) && blockLeftIsM === (blockLeft === m.U) &&
+      blockLeftAtLeast2m === (blockLeft >= (2 * m).U), "the block-end flags do not match their counters")
+  }
   // The A block is copied from aNext through the startup and at each block change.
   val aLoad = replicatedEnable(
     "aLoad",
@@ -250,15 +260,19 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     when(!blockEnd) {
       s        := s + 1.U
       left     := left - 1.U
-      blockEndNext := left === 1.U
+      leftIsOne := left === 2.U
+      blockEndNext := leftIsOne
       capture  := (capture << 1)(m - 1, 0)
     }.elsewhen(hasNextBlock) {
       base         := base + m.U
       s            := base + (m + 1).U
       left         := blockLeft - m.U
       blockLeft    := blockLeft - m.U
-      blockEndNext     := blockLeft === m.U
-      hasNextBlockNext := blockLeft >= (2 * m).U
+      leftIsOne          := blockLeft === (m + 1).U
+      blockLeftIsM       := blockLeft === (2 * m).U
+      blockLeftAtLeast2m := blockLeft >= (3 * m).U
+      blockEndNext     := blockLeftIsM
+      hasNextBlockNext := blockLeftAtLeast2m
       capture      := 1.U
     }.otherwise {
       issuingNext := false.B
@@ -280,6 +294,9 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     s         := 1.U
     left      := count - 2.U
     blockLeft := count - 2.U
+    leftIsOne          := count === 3.U
+    blockLeftIsM       := count === (m + 2).U
+    blockLeftAtLeast2m := count >= (2 * m + 2).U
     blockEndNext     := count === 2.U
     hasNextBlockNext := count >= (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 3 else 2)).U
     capture   := 1.U
