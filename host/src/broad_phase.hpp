@@ -41,9 +41,10 @@ struct HostTimes {
 /// threads).
 ///
 /// `cellsPerBatch` > 1 hands cells to the backend in batches
-/// (Backend::runBatch): each worker copies the cells it is given, packed,
-/// into the batch it is filling and hands it over when it holds that many
-/// cells, and at the end of the frame. One batch is one hand-over to the
+/// (Backend::runBatch): each worker adds the cells it is given, packed, to
+/// the batch it is filling (referring to the partition's storage where it
+/// outlives the batch, as the grid's does; else copying) and hands it over
+/// when it holds that many cells, and at the end of the frame. One batch is one hand-over to the
 /// device (one link latency). With 1, each cell is handed over on its own,
 /// straight from the partition's storage.
 class BroadPhase {
