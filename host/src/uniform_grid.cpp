@@ -31,23 +31,29 @@ double valueOf(std::uint32_t key) {
 // axis's constants. Every step is monotone in the key; nothing is NaN: the
 // clamped values are finite, so are their halves' differences, and a finite
 // product may only round to an infinity, which the clamp to [0, last] takes.
+// kAnyKey = false is for keys known to lie in [keyLo, keyHi] of the axis with
+// both finite: there both clamps below are the identity (value >= from, so
+// value / 2 >= from / 2, both rounded alike), and the result is the same.
+template <bool kAnyKey = true>
 __m128i cellsOf(__m128i keys, __m128 fromHalf, __m128 scale, __m128 last) {
   const __m128i sign = _mm_set1_epi32(static_cast<int>(0x80000000u));
-  // Keys with the sign bit flipped order as signed integers (SSE2 has only signed compares).
-  const __m128i lowest = _mm_set1_epi32(static_cast<int>(kLowestFinite ^ 0x80000000u));
-  const __m128i highest = _mm_set1_epi32(static_cast<int>(kHighestFinite ^ 0x80000000u));
   __m128i k = _mm_xor_si128(keys, sign);
-  __m128i below = _mm_cmpgt_epi32(lowest, k);
-  k = _mm_or_si128(_mm_and_si128(below, lowest), _mm_andnot_si128(below, k));
-  const __m128i above = _mm_cmpgt_epi32(k, highest);
-  k = _mm_or_si128(_mm_and_si128(above, highest), _mm_andnot_si128(above, k));
+  if constexpr (kAnyKey) {
+    // Keys with the sign bit flipped order as signed integers (SSE2 has only signed compares).
+    const __m128i lowest = _mm_set1_epi32(static_cast<int>(kLowestFinite ^ 0x80000000u));
+    const __m128i highest = _mm_set1_epi32(static_cast<int>(kHighestFinite ^ 0x80000000u));
+    const __m128i below = _mm_cmpgt_epi32(lowest, k);
+    k = _mm_or_si128(_mm_and_si128(below, lowest), _mm_andnot_si128(below, k));
+    const __m128i above = _mm_cmpgt_epi32(k, highest);
+    k = _mm_or_si128(_mm_and_si128(above, highest), _mm_andnot_si128(above, k));
+  }
   // floatToKey's inverse on flipped keys: positive floats are k itself,
   // negative ones ~key = k ^ 0x7FFFFFFF.
   const __m128i bits = _mm_xor_si128(k, _mm_and_si128(_mm_srai_epi32(k, 31), _mm_set1_epi32(0x7FFFFFFF)));
   const __m128 value = _mm_castsi128_ps(bits);
   __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(value, _mm_set1_ps(0.5f)), fromHalf), scale);
-  x = _mm_min_ps(_mm_max_ps(x, _mm_setzero_ps()), last);
-  return _mm_cvttps_epi32(x);
+  if constexpr (kAnyKey) x = _mm_max_ps(x, _mm_setzero_ps());
+  return _mm_cvttps_epi32(_mm_min_ps(x, last));
 }
 #endif
 
@@ -70,6 +76,8 @@ std::uint32_t UniformGrid::Axis::cellOf(std::uint32_t key) const {
 // each plane is the first key the cell function maps to its cell (none: the
 // cell's region is empty and it never holds a box).
 void UniformGrid::Axis::place(std::uint32_t lo, std::uint32_t hi, std::uint32_t count) {
+  keyLo = lo;
+  keyHi = hi;
   const double from = valueOf(lo), to = valueOf(hi);
   if (!(to > from)) count = 1;
   fromHalf = static_cast<float>(from * 0.5);
@@ -236,16 +244,26 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
     scale[v] = _mm_setr_ps(lane(0).scale, lane(1).scale, lane(2).scale, lane(3).scale);
     last[v] = _mm_setr_ps(lane(0).last, lane(1).last, lane(2).last, lane(3).last);
   }
-  const auto* words = reinterpret_cast<const char*>(boxes.data());
-  for (; i + 2 <= boxes.size(); i += 2) {
-    alignas(16) std::array<std::uint32_t, 12> c;
-    for (int v = 0; v < 3; ++v) {
-      const __m128i keys = _mm_loadu_si128(reinterpret_cast<const __m128i*>(words + 24 * i + 16 * v));
-      _mm_store_si128(reinterpret_cast<__m128i*>(c.data() + 4 * v), cellsOf(keys, fromHalf[v], scale[v], last[v]));
+  const auto twoAtATime = [&]<bool kAnyKey>() {
+    const auto* words = reinterpret_cast<const char*>(boxes.data());
+    for (; i + 2 <= boxes.size(); i += 2) {
+      alignas(16) std::array<std::uint32_t, 12> c;
+      for (int v = 0; v < 3; ++v) {
+        const __m128i keys = _mm_loadu_si128(reinterpret_cast<const __m128i*>(words + 24 * i + 16 * v));
+        _mm_store_si128(reinterpret_cast<__m128i*>(c.data() + 4 * v),
+                        cellsOf<kAnyKey>(keys, fromHalf[v], scale[v], last[v]));
+      }
+      record(i, c.data());
+      record(i + 1, c.data() + 6);
     }
-    record(i, c.data());
-    record(i + 1, c.data() + 6);
-  }
+  };
+  // The bench's scenes and any from float boxes without infinities have finite bounds.
+  bool finite = true;
+  for (const Axis& axis : axes_) finite = finite && axis.keyLo >= kLowestFinite && axis.keyHi <= kHighestFinite;
+  if (finite)
+    twoAtATime.template operator()<false>();
+  else
+    twoAtATime.template operator()<true>();
 #endif
   for (; i < boxes.size(); ++i) {
     std::array<std::uint32_t, 6> c;
@@ -256,15 +274,28 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
     record(i, c.data());
   }
   straddling_ = straddling;
-  // The straddlers' other cells, within the cap on entries.
+  // The straddlers' other cells, within the cap on entries, listed first
+  // (stores to consecutive slots, branch-free for nearly all), then counted.
   const std::uint64_t cap = kMaxEntriesPerBox * boxes.size();
   std::uint64_t entries = boxes.size();
-  for (const Range& r : std::span<const Range>(straddlerRanges_).first(straddling_)) {
-    entries += std::uint64_t{r.last[0] - r.first[0] + 1u} * (r.last[1] - r.first[1] + 1u) *
-                   (r.last[2] - r.first[2] + 1u) - 1;
+  std::size_t extra = 0;
+  for (std::size_t k = 0; k < straddling_; ++k) {
+    const Range& r = ranges[k];
+    const std::uint64_t others = std::uint64_t{r.last[0] - r.first[0] + 1u} * (r.last[1] - r.first[1] + 1u) *
+                                     (r.last[2] - r.first[2] + 1u) - 1;
+    entries += others;
     if (entries > cap) return false;
-    forEachOtherCell(r, [counts](std::uint64_t cell, unsigned inside) { counts[cell] += inside; });
+    // Room for every slot written, the seven of the branch-free path included.
+    if (extras_.size() < extra + std::max<std::uint64_t>(others, 7)) extras_.resize(2 * (extra + others) + 8);
+    Extra* const slots = extras_.data();
+    const std::uint32_t id = straddlers[k];
+    forEachOtherCell(r, [&](std::uint64_t cell, unsigned inside) {
+      slots[extra] = {cell, id};
+      extra += inside;
+    });
   }
+  extraCount_ = extra;
+  for (const Extra& e : std::span<const Extra>(extras_).first(extraCount_)) ++counts[e.cell];
   return true;
 }
 
@@ -274,14 +305,11 @@ void UniformGrid::forEachOtherCell(const Range& r, F&& f) const {
   const unsigned dx = r.last[0] - r.first[0], dy = r.last[1] - r.first[1], dz = r.last[2] - r.first[2];
   if ((dx | dy | dz) <= 1) {
     const std::uint64_t base = (std::uint64_t{r.first[2]} * ny + r.first[1]) * nx + r.first[0];
-    const std::uint64_t dummies = nx * ny * axes_[2].cells();
     for (unsigned o = 1; o < 8; ++o) {
       const unsigned ox = o & 1, oy = (o >> 1) & 1, oz = o >> 2;
       const unsigned inside = static_cast<unsigned>(ox <= dx) & static_cast<unsigned>(oy <= dy) &
                               static_cast<unsigned>(oz <= dz);
-      const std::uint64_t dummy = dummies + o - 1;
-      // A select by arithmetic: the compiler keeps it branch-free.
-      f(dummy + (base + ox + oy * nx + oz * nx * ny - dummy) * inside, inside);
+      f(base + ox + oy * nx + oz * nx * ny, inside);
     }
     return;
   }
@@ -298,7 +326,7 @@ void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, con
   chooseResolution(boxes, cellSize);
   const std::uint32_t nx = axes_[0].cells(), ny = axes_[1].cells(), nz = axes_[2].cells();
   const std::size_t cellCount = std::size_t{nx} * ny * nz;
-  offsets_.assign(cellCount + kDummyCells, 0);
+  offsets_.assign(cellCount, 0);
   fellBack_ = !countBoxes(boxes);
   if (fellBack_) {
     fallback_.build(boxes, cellSize, onCell);
@@ -319,8 +347,7 @@ void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, con
                           {axes_[0].planes[x + 1], axes_[1].planes[y + 1], axes_[2].planes[z + 1]}});
         total += count;
       }
-  for (std::size_t d = 0; d < kDummyCells; ++d) offsets_[cellCount + d] = total;
-  items_.resize(total + 1);  // the dummy cells' slot
+  items_.resize(total);
   packed_.resize(total);
   // Scatter (offsets_ becomes the cursor): every box into its first cell,
   // then the straddlers into their others.
@@ -329,13 +356,7 @@ void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, con
   KeyBox* const packed = packed_.data();
   const std::uint32_t* const firsts = firstCell_.data();
   for (std::size_t i = 0; i < boxes.size(); ++i) items[cursor[firsts[i]]++] = static_cast<std::uint32_t>(i);
-  for (std::size_t k = 0; k < straddling_; ++k) {
-    const std::uint32_t id = straddlers_[k];
-    forEachOtherCell(straddlerRanges_[k], [&](std::uint64_t cell, unsigned inside) {
-      items[cursor[cell]] = id;
-      cursor[cell] += inside;
-    });
-  }
+  for (const Extra& e : std::span<const Extra>(extras_).first(extraCount_)) items[cursor[e.cell]++] = e.id;
   // The boxes gathered in cell order: writing them in order is cheaper than
   // scattering them with their indices (one cache line filled at a time).
   for (std::uint64_t t = 0; t < total; ++t) packed[t] = boxes[items[t]];

@@ -77,7 +77,7 @@ class UniformGrid final : public Partition {
   /// Item entries the grid's buffers hold (their capacity).
   std::size_t storedItems() const {
     return items_.capacity() + offsets_.capacity() + firstCell_.capacity() +
-           straddlers_.capacity() + straddlerRanges_.capacity();
+           straddlers_.capacity() + straddlerRanges_.capacity() + extras_.capacity();
   }
   /// Boxes the grid's packed copy holds (its capacity).
   std::size_t storedBoxes() const { return packed_.capacity(); }
@@ -88,6 +88,7 @@ class UniformGrid final : public Partition {
   struct Axis {
     std::vector<std::uint64_t> planes;
     float fromHalf = 0, scale = 0, last = 0;  // half the lowest value, cells per half unit, cells - 1
+    std::uint32_t keyLo = 0, keyHi = 0;       // the scene's bounds on the axis
     std::uint32_t cells() const { return static_cast<std::uint32_t>(planes.size() - 1); }
     std::uint32_t cellOf(std::uint32_t key) const;
     void place(std::uint32_t keyLo, std::uint32_t keyHi, std::uint32_t cells);
@@ -100,20 +101,24 @@ class UniformGrid final : public Partition {
   void chooseResolution(std::span<const KeyBox> boxes, std::size_t cellSize);
   // Calls f(cell, 1) for each cell of r but its first: branch-free when r
   // spans at most two cells an axis (boxes smaller than cells, nearly every
-  // straddler), with f(a dummy cell of its own, 0) for each of the seven
-  // neighbours the box misses; else by loops.
+  // straddler), with f(any number, 0) for each of the seven neighbours the
+  // box misses; else by loops.
   template <typename F>
   void forEachOtherCell(const Range& r, F&& f) const;
-  // The dummy cells follow the real ones in offsets_; their cursor is the
-  // slot after the last item.
-  static constexpr std::size_t kDummyCells = 7;
+  // A straddler's entry in one of its other cells.
+  struct Extra {
+    std::uint64_t cell;
+    std::uint32_t id;
+  };
 
   std::array<Axis, 3> axes_;
   std::vector<std::uint32_t> firstCell_;  // each box's first cell (its min corner's)
   std::vector<std::uint32_t> straddlers_;  // boxes in more than one cell, with their ranges
   std::vector<Range> straddlerRanges_;
   std::size_t straddling_ = 0;            // how many of those two hold this frame's straddlers
-  std::vector<std::uint64_t> offsets_;   // per cell (and dummy): its count, then its first item, then the scatter cursor
+  std::vector<Extra> extras_;             // the straddlers' entries in their other cells
+  std::size_t extraCount_ = 0;            // how many of those this frame holds
+  std::vector<std::uint64_t> offsets_;   // per cell: its count, then its first item, then the scatter cursor
   std::vector<std::uint32_t> items_;     // the cells' item lists, in cell order
   std::vector<KeyBox> packed_;           // their boxes, in the same order
   std::vector<Cell> cells_;
