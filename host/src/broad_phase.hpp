@@ -19,7 +19,8 @@ namespace bpaccel {
 /// Host time of one findPairs call, by part (measured with a steady clock).
 struct HostTimes {
   double convertSeconds = 0;  // float to key conversion and validation
-  double partitionSeconds = 0;  // partition build (k-d tree or grid), without the cells' processing
+  double partitionSeconds = 0;  // partition build (k-d tree or grid, with the grid's packing of its cells'
+                                // boxes), without the cells' processing
   double cellsSeconds = 0;    // packing, backend runs, decoding and filtering
   double backendSeconds = 0;  // inside Backend::run (simulating the device, or the cpu test itself),
                               // summed over the worker threads
