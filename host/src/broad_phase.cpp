@@ -33,11 +33,15 @@ struct BroadPhase::Worker {
   Clock::time_point frameStart;
   std::vector<RunRecord> runs;
 
-  // The batch being filled: its cells' items and boxes back to back, and how
-  // to filter each cell's pairs. A cell's region is copied: the tree's leaf
-  // list grows (and moves) while the batch fills.
+  // The batch being filled: its cells' items and boxes (referred to where
+  // they outlive the batch, else copied back to back), and how to filter each
+  // cell's pairs. A cell's region is copied: the tree's leaf list grows (and
+  // moves) while the batch fills.
   struct PendingCell {
-    std::size_t begin = 0, count = 0;
+    std::span<const std::uint32_t> items;  // when referred to
+    std::span<const KeyBox> boxes;
+    bool copied = false;
+    std::size_t begin = 0, count = 0;      // when copied: where in pendingItems and pendingBoxes
     Cell region{};
     bool hasRegion = false;
     std::size_t splitAt = 0;
@@ -47,13 +51,15 @@ struct BroadPhase::Worker {
   std::vector<std::uint32_t> pendingItems;
   std::vector<KeyBox> pendingBoxes;
   std::vector<std::span<const KeyBox>> cellSpans;
+  std::vector<std::span<const std::uint32_t>> cellItems;
   std::vector<std::size_t> cellEnds;
 
   // One device cell: a partition cell or a chunk pair. `packed`: its boxes in item
-  // order when the caller has them (carried tree leaves, the whole scene), else
-  // empty: they are gathered from `keys`.
+  // order when the caller has them (carried tree leaves, grid cells, the whole
+  // scene), else empty: they are gathered from `keys`. `lasting`: items and
+  // packed stay valid until the batch is flushed, so a batch refers to them.
   void submit(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-              const Cell* region, std::size_t splitAt, int keep);
+              const Cell* region, std::size_t splitAt, int keep, bool lasting);
   void runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
               const Cell* region, std::size_t splitAt, int keep);
   void flush();  // hands the pending batch over, if any
@@ -64,7 +70,7 @@ struct BroadPhase::Worker {
   void keepPairs(std::span<const Pair> pairs, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
                  const Cell* region, std::size_t splitAt, int keep);
   void processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-                   const Cell* region, std::size_t capacity);
+                   const Cell* region, std::size_t capacity, bool lasting);
 };
 
 /// The threads of a multi-threaded BroadPhase: an arena of its own, so the
@@ -140,7 +146,7 @@ void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out)
   if (!cellSize_) {
     identity_.resize(keys.size());
     std::iota(identity_.begin(), identity_.end(), 0u);
-    workers_.front()->processCell(keys, identity_, keys, nullptr, capacity_);
+    workers_.front()->processCell(keys, identity_, keys, nullptr, capacity_, true);
     workers_.front()->flush();
     times_.cellsSeconds = seconds(t0, Clock::now());
   } else if (!pool_) {
@@ -161,7 +167,7 @@ void BroadPhase::streamCells(std::span<const KeyBox> keys) {
   partition_->build(keys, *cellSize_, [&](const Cell& leaf, std::span<const std::uint32_t> items,
                                           std::span<const KeyBox> packed) {
     const auto c0 = Clock::now();
-    w.processCell(keys, items, packed, &leaf, capacity_);
+    w.processCell(keys, items, packed, &leaf, capacity_, partition_->cellsOutliveBuild());
     inCells += seconds(c0, Clock::now());
   });
   const auto f0 = Clock::now();
@@ -191,7 +197,7 @@ void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys) {
       tasks.run([this, keys, leaf, &copy] {
         // Inside this arena, thread indices are 0 .. threads-1: one worker each.
         Worker& w = *workers_.at(static_cast<std::size_t>(tbb::this_task_arena::current_thread_index()));
-        w.processCell(keys, copy.items, copy.packed, &leaf, capacity_);
+        w.processCell(keys, copy.items, copy.packed, &leaf, capacity_, false);
       });
     });
     built = Clock::now();
@@ -233,10 +239,10 @@ void BroadPhase::finishCells(std::vector<Pair>& out) {
 // p from run (p, p+1), the last chunk from run (k-2, k-1).
 void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
                                      std::span<const KeyBox> packed, const Cell* region,
-                                     std::size_t capacity) {
+                                     std::size_t capacity, bool lasting) {
   if (items.size() < 2) return;
   if (items.size() <= capacity) {
-    submit(keys, items, packed, region, items.size(), kFirstInside);
+    submit(keys, items, packed, region, items.size(), kFirstInside, lasting);
     return;
   }
   const std::size_t chunk = capacity / 2;
@@ -251,30 +257,36 @@ void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<con
       int keep = kCross;
       if (q == p + 1) keep |= kFirstInside;
       if (p == k - 2 && q == k - 1) keep |= kSecondInside;
-      submit(keys, pairItems, {}, region, first.size(), keep);
+      submit(keys, pairItems, {}, region, first.size(), keep, false);
     }
   }
 }
 
 void BroadPhase::Worker::submit(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
                                 std::span<const KeyBox> packed, const Cell* region, std::size_t splitAt,
-                                int keep) {
+                                int keep, bool lasting) {
   if (cellsPerBatch <= 1) {
     runNow(keys, items, packed, region, splitAt, keep);
     return;
   }
   PendingCell cell;
-  cell.begin = pendingItems.size();
-  cell.count = items.size();
   if (region) cell.region = *region;
   cell.hasRegion = region != nullptr;
   cell.splitAt = splitAt;
   cell.keep = keep;
-  pendingItems.insert(pendingItems.end(), items.begin(), items.end());
-  if (packed.empty())
-    for (const std::uint32_t id : items) pendingBoxes.push_back(keys[id]);
-  else
-    pendingBoxes.insert(pendingBoxes.end(), packed.begin(), packed.end());
+  if (lasting && !packed.empty()) {
+    cell.items = items;
+    cell.boxes = packed;
+  } else {
+    cell.copied = true;
+    cell.begin = pendingItems.size();
+    cell.count = items.size();
+    pendingItems.insert(pendingItems.end(), items.begin(), items.end());
+    if (packed.empty())
+      for (const std::uint32_t id : items) pendingBoxes.push_back(keys[id]);
+    else
+      pendingBoxes.insert(pendingBoxes.end(), packed.begin(), packed.end());
+  }
   pending.push_back(cell);
   if (pending.size() >= cellsPerBatch) flush();
 }
@@ -282,7 +294,11 @@ void BroadPhase::Worker::submit(std::span<const KeyBox> keys, std::span<const st
 void BroadPhase::Worker::flush() {
   if (pending.empty()) return;
   cellSpans.clear();
-  for (const PendingCell& c : pending) cellSpans.push_back(std::span<const KeyBox>(pendingBoxes).subspan(c.begin, c.count));
+  cellItems.clear();
+  for (const PendingCell& c : pending) {
+    cellSpans.push_back(c.copied ? std::span<const KeyBox>(pendingBoxes).subspan(c.begin, c.count) : c.boxes);
+    cellItems.push_back(c.copied ? std::span<const std::uint32_t>(pendingItems).subspan(c.begin, c.count) : c.items);
+  }
   local.clear();
   cellEnds.clear();
   handOver(
@@ -296,8 +312,7 @@ void BroadPhase::Worker::flush() {
         std::size_t from = 0;
         for (std::size_t c = 0; c < pending.size(); ++c) {
           const PendingCell& cell = pending[c];
-          keepPairs(std::span<const Pair>(local).subspan(from, cellEnds[c] - from),
-                    std::span<const std::uint32_t>(pendingItems).subspan(cell.begin, cell.count), cellSpans[c],
+          keepPairs(std::span<const Pair>(local).subspan(from, cellEnds[c] - from), cellItems[c], cellSpans[c],
                     cell.hasRegion ? &cell.region : nullptr, cell.splitAt, cell.keep);
           from = cellEnds[c];
         }

@@ -19,7 +19,8 @@ namespace bpaccel {
 /// Host time of one findPairs call, by part (measured with a steady clock).
 struct HostTimes {
   double convertSeconds = 0;  // float to key conversion and validation
-  double partitionSeconds = 0;  // partition build (k-d tree or grid), without the cells' processing
+  double partitionSeconds = 0;  // partition build (k-d tree or grid, with the grid's packing of its cells'
+                                // boxes), without the cells' processing
   double cellsSeconds = 0;    // packing, backend runs, decoding and filtering
   double backendSeconds = 0;  // inside Backend::run (simulating the device, or the cpu test itself),
                               // summed over the worker threads
@@ -41,9 +42,10 @@ struct HostTimes {
 /// threads).
 ///
 /// `cellsPerBatch` > 1 hands cells to the backend in batches
-/// (Backend::runBatch): each worker copies the cells it is given, packed,
-/// into the batch it is filling and hands it over when it holds that many
-/// cells, and at the end of the frame. One batch is one hand-over to the
+/// (Backend::runBatch): each worker adds the cells it is given, packed, to
+/// the batch it is filling (referring to the partition's storage where it
+/// outlives the batch, as the grid's does; else copying) and hands it over
+/// when it holds that many cells, and at the end of the frame. One batch is one hand-over to the
 /// device (one link latency). With 1, each cell is handed over on its own,
 /// straight from the partition's storage.
 class BroadPhase {

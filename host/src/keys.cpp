@@ -2,6 +2,10 @@
 
 #include <bit>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 #include <fmt/format.h>
 
 namespace bpaccel {
@@ -66,15 +70,62 @@ bool isBad(const Aabb& b, const KeyBox& k) {
   throw std::logic_error("toKeys: a bad box was flagged but not found");
 }
 
+#if defined(__x86_64__)
+// Two boxes (12 words, 3 vectors) a step with SSE2, the baseline of x86-64:
+// keyOfBits and isNaNBits lane by lane, and min > max by comparing each min
+// word with the word three further on. Returns the index of the first box
+// left to the scalar loop; `bad` collects any bad lane.
+std::size_t toKeysSse2(std::span<const Aabb> boxes, std::vector<KeyBox>& out, bool& bad) {
+  static_assert(sizeof(Aabb) == 24 && sizeof(KeyBox) == 24, "two boxes are three 16-byte vectors");
+  const __m128i signBit = _mm_set1_epi32(static_cast<int>(kSignBit));
+  const __m128i magnitude = _mm_set1_epi32(static_cast<int>(~kSignBit));
+  const __m128i exponent = _mm_set1_epi32(static_cast<int>(kExponentMask));
+  // Which lanes hold a min word (its max is three words on): words 0-2 and 6-8 of the 12.
+  const __m128i minLanes[3] = {_mm_setr_epi32(-1, -1, -1, 0), _mm_setr_epi32(0, 0, -1, -1), _mm_setr_epi32(-1, 0, 0, 0)};
+  const auto key = [&](__m128i bits) {
+    bits = _mm_andnot_si128(_mm_cmpeq_epi32(bits, signBit), bits);  // -0.0 becomes +0.0
+    return _mm_xor_si128(bits, _mm_or_si128(_mm_srai_epi32(bits, 31), signBit));
+  };
+  __m128i flags = _mm_setzero_si128();
+  const auto* in = reinterpret_cast<const char*>(boxes.data());
+  auto* to = reinterpret_cast<char*>(out.data());
+  std::size_t i = 0;
+  for (; i + 2 <= boxes.size(); i += 2) {
+    __m128i w[3], k[3];
+    for (int v = 0; v < 3; ++v) {
+      w[v] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + 24 * i + 16 * v));
+      flags = _mm_or_si128(flags, _mm_cmpgt_epi32(_mm_and_si128(w[v], magnitude), exponent));  // NaN
+      k[v] = key(w[v]);
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(to + 24 * i + 16 * v), k[v]);
+    }
+    // Words 3-6, 7-10 and 11: the max beside each min lane.
+    const __m128i above[3] = {_mm_or_si128(_mm_srli_si128(k[0], 12), _mm_slli_si128(k[1], 4)),
+                              _mm_or_si128(_mm_srli_si128(k[1], 12), _mm_slli_si128(k[2], 4)),
+                              _mm_srli_si128(k[2], 12)};
+    for (int v = 0; v < 3; ++v) {
+      // Unsigned min > max as a signed compare with the sign bits flipped.
+      const __m128i inverted = _mm_cmpgt_epi32(_mm_xor_si128(k[v], signBit), _mm_xor_si128(above[v], signBit));
+      flags = _mm_or_si128(flags, _mm_and_si128(inverted, minLanes[v]));
+    }
+  }
+  bad |= _mm_movemask_epi8(flags) != 0;
+  return i;
+}
+#endif
+
 }  // namespace
 
 void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out) {
   checkObjectCount(boxes.size());
   out.resize(boxes.size());
-  // One branch-free pass that converts and only accumulates a flag, so the
-  // compiler can vectorise it; the rare bad input is located afterwards.
+  // Branch-free passes that convert and only accumulate a flag; the rare bad
+  // input is located afterwards.
   bool bad = false;
-  for (std::size_t i = 0; i < boxes.size(); ++i) {
+  std::size_t first = 0;
+#if defined(__x86_64__)
+  first = toKeysSse2(boxes, out, bad);
+#endif
+  for (std::size_t i = first; i < boxes.size(); ++i) {
     const Aabb& b = boxes[i];
     KeyBox& k = out[i];
     for (int a = 0; a < 3; ++a) {

@@ -52,6 +52,10 @@ class Partition {
   virtual const std::vector<Cell>& cells() const = 0;
   /// Box indices of a cell of the last build.
   virtual std::span<const std::uint32_t> items(const Cell& cell) const = 0;
+  /// Whether the items and packed boxes the last build handed to its sink
+  /// stay valid until the next build (a batch may then refer to them instead
+  /// of copying); otherwise they are valid during the call only.
+  virtual bool cellsOutliveBuild() const { return false; }
 };
 
 enum class PartitionKind { KdTree, UniformGrid };

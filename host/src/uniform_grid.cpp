@@ -5,68 +5,151 @@
 #include <cmath>
 #include <limits>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 #include "keys.hpp"
 
 namespace bpaccel {
 namespace {
 
 constexpr std::uint64_t kTop = std::uint64_t{1} << 32;
+constexpr std::uint32_t kLowestFinite = 0x00800000u;   // floatToKey(-FLT_MAX)
+constexpr std::uint32_t kHighestFinite = 0xFF7FFFFFu;  // floatToKey(FLT_MAX)
 
 // The float of a key (floatToKey's inverse) as a double, clamped to the
 // finite floats (keys beyond them: the infinities and NaN bit patterns, which
 // the KeyBox API lets through). Places planes only.
 double valueOf(std::uint32_t key) {
-  constexpr std::uint32_t kLowestFinite = 0x00800000u;   // floatToKey(-FLT_MAX)
-  constexpr std::uint32_t kHighestFinite = 0xFF7FFFFFu;  // floatToKey(FLT_MAX)
   key = std::clamp(key, kLowestFinite, kHighestFinite);
   return static_cast<double>(std::bit_cast<float>(key & 0x80000000u ? key & 0x7FFFFFFFu : ~key));
 }
 
+#if defined(__x86_64__)
+// The cell function (see UniformGrid) on four keys, each lane with its own
+// axis's constants. Every step is monotone in the key; nothing is NaN: the
+// clamped values are finite, so are their halves' differences, and a finite
+// product may only round to an infinity, which the clamp to [0, last] takes.
+// kAnyKey = false is for keys known to lie in [keyLo, keyHi] of the axis with
+// both finite: there both clamps below are the identity (value >= from, so
+// value / 2 >= from / 2, both rounded alike), and the result is the same.
+template <bool kAnyKey = true>
+__m128i cellsOf(__m128i keys, __m128 fromHalf, __m128 scale, __m128 last) {
+  const __m128i sign = _mm_set1_epi32(static_cast<int>(0x80000000u));
+  __m128i k = _mm_xor_si128(keys, sign);
+  if constexpr (kAnyKey) {
+    // Keys with the sign bit flipped order as signed integers (SSE2 has only signed compares).
+    const __m128i lowest = _mm_set1_epi32(static_cast<int>(kLowestFinite ^ 0x80000000u));
+    const __m128i highest = _mm_set1_epi32(static_cast<int>(kHighestFinite ^ 0x80000000u));
+    const __m128i below = _mm_cmpgt_epi32(lowest, k);
+    k = _mm_or_si128(_mm_and_si128(below, lowest), _mm_andnot_si128(below, k));
+    const __m128i above = _mm_cmpgt_epi32(k, highest);
+    k = _mm_or_si128(_mm_and_si128(above, highest), _mm_andnot_si128(above, k));
+  }
+  // floatToKey's inverse on flipped keys: positive floats are k itself,
+  // negative ones ~key = k ^ 0x7FFFFFFF.
+  const __m128i bits = _mm_xor_si128(k, _mm_and_si128(_mm_srai_epi32(k, 31), _mm_set1_epi32(0x7FFFFFFF)));
+  const __m128 value = _mm_castsi128_ps(bits);
+  __m128 x = _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(value, _mm_set1_ps(0.5f)), fromHalf), scale);
+  if constexpr (kAnyKey) x = _mm_max_ps(x, _mm_setzero_ps());
+  return _mm_cvttps_epi32(_mm_min_ps(x, last));
+}
+#endif
+
 }  // namespace
 
-// `count` cells evenly spaced in world units over [value(lo), value(hi)],
-// each plane rounded up to a bucket boundary (a cell narrower than a bucket
-// may get no key at all: its region is empty and it never holds a box).
-void UniformGrid::Axis::place(std::uint32_t lo, std::uint32_t hi, std::uint32_t count) {
-  keyLo = lo;
-  const double from = valueOf(lo), to = valueOf(hi);
-  if (!(to > from)) count = 1;
-  const double width = (to - from) / count;
-  // A key step at magnitude 2^e is 2^(e - 23) world units (an octave holds
-  // 2^23 keys), largest at the scene's largest magnitude: make a bucket
-  // there an eighth of a cell, within kMaxBuckets.
-  shift = 32;
-  if (count > 1) {
-    const double top = std::max({std::fabs(from), std::fabs(to), double{std::numeric_limits<float>::min()}});
-    const double want = std::floor(std::log2(width / 8) + 23 - std::ilogb(top));
-    shift = static_cast<unsigned>(std::clamp(want, 0.0, 32.0));
-  }
-  while (shift < 32 && (std::uint64_t{hi - lo} >> shift) >= kMaxBuckets) ++shift;
-  const std::uint64_t buckets = (std::uint64_t{hi - lo} >> shift) + 1;
-  table.resize(buckets);
-  planes.assign(1, 0);
-  std::uint64_t first = 0;  // the current cell's first bucket
-  for (std::uint32_t c = 1; c <= count; ++c) {
-    std::uint64_t next = buckets;  // the next cell's first bucket
-    if (c < count) {
-      const std::uint32_t plane = floatToKey(static_cast<float>(from + width * c));
-      const std::uint64_t above = plane > lo ? plane - lo : 0;
-      next = std::clamp((above + (std::uint64_t{1} << shift) - 1) >> shift, first, buckets);
-    }
-    std::fill(table.begin() + static_cast<std::ptrdiff_t>(first), table.begin() + static_cast<std::ptrdiff_t>(next),
-              static_cast<std::uint16_t>(c - 1));
-    planes.push_back(c < count ? std::min(lo + (next << shift), kTop) : kTop);
-    first = next;
-  }
+std::uint32_t UniformGrid::Axis::cellOf(std::uint32_t key) const {
+#if defined(__x86_64__)
+  // The very arithmetic of the vector loop, so planes and boxes agree.
+  return static_cast<std::uint32_t>(_mm_cvtsi128_si32(cellsOf(_mm_set1_epi32(static_cast<int>(key)),
+                                                               _mm_set1_ps(fromHalf), _mm_set1_ps(scale),
+                                                               _mm_set1_ps(last))));
+#else
+  key = std::clamp(key, kLowestFinite, kHighestFinite);
+  const float value = std::bit_cast<float>(key & 0x80000000u ? key & 0x7FFFFFFFu : ~key);
+  return static_cast<std::uint32_t>(std::min(std::max((value * 0.5f - fromHalf) * scale, 0.0f), last));
+#endif
 }
 
-void UniformGrid::chooseResolution(std::span<const KeyBox> boxes, std::size_t cellSize) {
-  std::array<std::uint32_t, 3> lo{~0u, ~0u, ~0u}, hi{0, 0, 0};
-  for (const KeyBox& b : boxes)
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], b.min[a]);
-      hi[a] = std::max(hi[a], b.max[a]);
+// `count` cells evenly spaced in world units over [value(lo), value(hi)];
+// each plane is the first key the cell function maps to its cell (none: the
+// cell's region is empty and it never holds a box).
+void UniformGrid::Axis::place(std::uint32_t lo, std::uint32_t hi, std::uint32_t count) {
+  keyLo = lo;
+  keyHi = hi;
+  const double from = valueOf(lo), to = valueOf(hi);
+  if (!(to > from)) count = 1;
+  fromHalf = static_cast<float>(from * 0.5);
+  const double perHalfUnit = count / ((to - from) * 0.5);
+  scale = count > 1 ? static_cast<float>(std::min(perHalfUnit, double{std::numeric_limits<float>::max()})) : 0.0f;
+  last = static_cast<float>(count - 1);
+  planes.assign(1, 0);
+  for (std::uint32_t c = 1; c < count; ++c) {
+    std::uint64_t first = planes.back(), end = kTop;  // the plane lies in [first, end]
+    while (first < end) {
+      const std::uint64_t mid = first + (end - first) / 2;
+      if (cellOf(static_cast<std::uint32_t>(mid)) >= c)
+        end = mid;
+      else
+        first = mid + 1;
     }
+    planes.push_back(first);
+  }
+  planes.push_back(kTop);
+}
+
+namespace {
+
+// The scene's bounds: the lowest min and the highest max per axis.
+void bounds(std::span<const KeyBox> boxes, std::array<std::uint32_t, 3>& lo, std::array<std::uint32_t, 3>& hi) {
+  lo = {~0u, ~0u, ~0u};
+  hi = {0, 0, 0};
+  std::size_t i = 0;
+#if defined(__x86_64__)
+  // Two boxes (three vectors) a step; every lane keeps both its least and its
+  // greatest key, and the lanes that hold mins and maxes are read at the end.
+  // Keys with the sign bit flipped order as SSE2's signed integers.
+  const __m128i sign = _mm_set1_epi32(static_cast<int>(0x80000000u));
+  __m128i least[3], greatest[3];
+  for (int v = 0; v < 3; ++v) {
+    least[v] = _mm_set1_epi32(std::numeric_limits<std::int32_t>::max());
+    greatest[v] = _mm_set1_epi32(std::numeric_limits<std::int32_t>::min());
+  }
+  const auto* words = reinterpret_cast<const char*>(boxes.data());
+  for (; i + 2 <= boxes.size(); i += 2)
+    for (int v = 0; v < 3; ++v) {
+      const __m128i k =
+          _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(words + 24 * i + 16 * v)), sign);
+      const __m128i lower = _mm_cmpgt_epi32(least[v], k), higher = _mm_cmpgt_epi32(k, greatest[v]);
+      least[v] = _mm_or_si128(_mm_and_si128(lower, k), _mm_andnot_si128(lower, least[v]));
+      greatest[v] = _mm_or_si128(_mm_and_si128(higher, k), _mm_andnot_si128(higher, greatest[v]));
+    }
+  for (int v = 0; v < 3; ++v) {
+    alignas(16) std::array<std::uint32_t, 4> l, g;
+    _mm_store_si128(reinterpret_cast<__m128i*>(l.data()), _mm_xor_si128(least[v], sign));
+    _mm_store_si128(reinterpret_cast<__m128i*>(g.data()), _mm_xor_si128(greatest[v], sign));
+    for (int lane = 0; lane < 4; ++lane) {
+      const int word = 4 * v + lane, axis = word % 3;  // words 0-2 and 6-8 of the twelve are mins
+      if (word % 6 < 3)
+        lo[axis] = std::min(lo[axis], l[lane]);
+      else
+        hi[axis] = std::max(hi[axis], g[lane]);
+    }
+  }
+#endif
+  for (; i < boxes.size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], boxes[i].min[a]);
+      hi[a] = std::max(hi[a], boxes[i].max[a]);
+    }
+}
+
+}  // namespace
+
+void UniformGrid::chooseResolution(std::span<const KeyBox> boxes, std::size_t cellSize) {
+  std::array<std::uint32_t, 3> lo, hi;
+  bounds(boxes, lo, hi);
   if (boxes.empty()) lo = hi;
   // ceil(2n / cellSize) cells (at most 2n, so memory stays linear in n).
   const double target = std::ceil(2.0 * static_cast<double>(boxes.size()) / static_cast<double>(cellSize));
@@ -117,7 +200,7 @@ std::array<std::uint32_t, 3> UniformGrid::resolution() const {
 // Every box's first cell (its min corner's) is counted branch-free; boxes
 // that straddle a plane (about a third on the bench's scene) are listed and
 // their other cells counted after, so the common case has no branch to
-// mispredict.
+// mispredict. The cells of two boxes (twelve keys) are computed at a time.
 bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
   const std::uint64_t nx = axes_[0].cells(), ny = axes_[1].cells();
   // Grow only: value-initialising the tail again every frame would cost a pass.
@@ -126,19 +209,18 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
     straddlers_.resize(boxes.size());
     straddlerRanges_.resize(boxes.size());
   }
-  // Locals: the loop's stores cannot be seen to leave the tables alone.
-  const std::array<Axis::Lookup, 3> look{axes_[0].lookup(), axes_[1].lookup(), axes_[2].lookup()};
+  // Locals: the loop's stores cannot be seen to leave the members alone.
   std::uint64_t* const counts = offsets_.data();
   std::uint32_t* const firsts = firstCell_.data();
   std::uint32_t* const straddlers = straddlers_.data();
   Range* const ranges = straddlerRanges_.data();
   std::size_t straddling = 0;
-  for (std::size_t i = 0; i < boxes.size(); ++i) {
-    const KeyBox& b = boxes[i];
+  // `c`: box i's cells, its min's on x, y, z, then its max's.
+  const auto record = [&](std::size_t i, const std::uint32_t* c) {
     Range r;
     for (int a = 0; a < 3; ++a) {
-      r.first[a] = look[a].cellOf(b.min[a]);
-      r.last[a] = look[a].cellOf(b.max[a]);
+      r.first[a] = static_cast<std::uint16_t>(c[a]);
+      r.last[a] = static_cast<std::uint16_t>(c[a + 3]);
     }
     const auto first = static_cast<std::uint32_t>((r.first[2] * ny + r.first[1]) * nx + r.first[0]);
     firsts[i] = first;
@@ -150,27 +232,91 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
     straddling += static_cast<std::size_t>(static_cast<unsigned>(r.first[0] != r.last[0]) |
                                            static_cast<unsigned>(r.first[1] != r.last[1]) |
                                            static_cast<unsigned>(r.first[2] != r.last[2]));
+  };
+  std::size_t i = 0;
+#if defined(__x86_64__)
+  static_assert(sizeof(KeyBox) == 24, "two boxes are three 16-byte vectors");
+  // The lanes' axes: x y z x | y z x y | z x y z.
+  __m128 fromHalf[3], scale[3], last[3];
+  for (int v = 0; v < 3; ++v) {
+    const auto lane = [&](int l) -> const Axis& { return axes_[(4 * v + l) % 3]; };
+    fromHalf[v] = _mm_setr_ps(lane(0).fromHalf, lane(1).fromHalf, lane(2).fromHalf, lane(3).fromHalf);
+    scale[v] = _mm_setr_ps(lane(0).scale, lane(1).scale, lane(2).scale, lane(3).scale);
+    last[v] = _mm_setr_ps(lane(0).last, lane(1).last, lane(2).last, lane(3).last);
+  }
+  const auto twoAtATime = [&]<bool kAnyKey>() {
+    const auto* words = reinterpret_cast<const char*>(boxes.data());
+    for (; i + 2 <= boxes.size(); i += 2) {
+      alignas(16) std::array<std::uint32_t, 12> c;
+      for (int v = 0; v < 3; ++v) {
+        const __m128i keys = _mm_loadu_si128(reinterpret_cast<const __m128i*>(words + 24 * i + 16 * v));
+        _mm_store_si128(reinterpret_cast<__m128i*>(c.data() + 4 * v),
+                        cellsOf<kAnyKey>(keys, fromHalf[v], scale[v], last[v]));
+      }
+      record(i, c.data());
+      record(i + 1, c.data() + 6);
+    }
+  };
+  // The bench's scenes and any from float boxes without infinities have finite bounds.
+  bool finite = true;
+  for (const Axis& axis : axes_) finite = finite && axis.keyLo >= kLowestFinite && axis.keyHi <= kHighestFinite;
+  if (finite)
+    twoAtATime.template operator()<false>();
+  else
+    twoAtATime.template operator()<true>();
+#endif
+  for (; i < boxes.size(); ++i) {
+    std::array<std::uint32_t, 6> c;
+    for (int a = 0; a < 3; ++a) {
+      c[a] = axes_[a].cellOf(boxes[i].min[a]);
+      c[a + 3] = axes_[a].cellOf(boxes[i].max[a]);
+    }
+    record(i, c.data());
   }
   straddling_ = straddling;
-  // The straddlers' other cells, within the cap on entries.
+  // The straddlers' other cells, within the cap on entries, listed first
+  // (stores to consecutive slots, branch-free for nearly all), then counted.
   const std::uint64_t cap = kMaxEntriesPerBox * boxes.size();
   std::uint64_t entries = boxes.size();
-  for (const Range& r : std::span<const Range>(straddlerRanges_).first(straddling_)) {
-    entries += std::uint64_t{r.last[0] - r.first[0] + 1u} * (r.last[1] - r.first[1] + 1u) *
-                   (r.last[2] - r.first[2] + 1u) - 1;
+  std::size_t extra = 0;
+  for (std::size_t k = 0; k < straddling_; ++k) {
+    const Range& r = ranges[k];
+    const std::uint64_t others = std::uint64_t{r.last[0] - r.first[0] + 1u} * (r.last[1] - r.first[1] + 1u) *
+                                     (r.last[2] - r.first[2] + 1u) - 1;
+    entries += others;
     if (entries > cap) return false;
-    forEachOtherCell(r, [&](std::uint64_t cell) { ++offsets_[cell]; });
+    // Room for every slot written, the seven of the branch-free path included.
+    if (extras_.size() < extra + std::max<std::uint64_t>(others, 7)) extras_.resize(2 * (extra + others) + 8);
+    Extra* const slots = extras_.data();
+    const std::uint32_t id = straddlers[k];
+    forEachOtherCell(r, [&](std::uint64_t cell, unsigned inside) {
+      slots[extra] = {cell, id};
+      extra += inside;
+    });
   }
+  extraCount_ = extra;
+  for (const Extra& e : std::span<const Extra>(extras_).first(extraCount_)) ++counts[e.cell];
   return true;
 }
 
 template <typename F>
 void UniformGrid::forEachOtherCell(const Range& r, F&& f) const {
   const std::uint64_t nx = axes_[0].cells(), ny = axes_[1].cells();
+  const unsigned dx = r.last[0] - r.first[0], dy = r.last[1] - r.first[1], dz = r.last[2] - r.first[2];
+  if ((dx | dy | dz) <= 1) {
+    const std::uint64_t base = (std::uint64_t{r.first[2]} * ny + r.first[1]) * nx + r.first[0];
+    for (unsigned o = 1; o < 8; ++o) {
+      const unsigned ox = o & 1, oy = (o >> 1) & 1, oz = o >> 2;
+      const unsigned inside = static_cast<unsigned>(ox <= dx) & static_cast<unsigned>(oy <= dy) &
+                              static_cast<unsigned>(oz <= dz);
+      f(base + ox + oy * nx + oz * nx * ny, inside);
+    }
+    return;
+  }
   for (std::uint32_t z = r.first[2]; z <= r.last[2]; ++z)
     for (std::uint32_t y = r.first[1]; y <= r.last[1]; ++y)
       for (std::uint32_t x = r.first[0]; x <= r.last[0]; ++x)
-        if (x != r.first[0] || y != r.first[1] || z != r.first[2]) f((z * ny + y) * nx + x);
+        if (x != r.first[0] || y != r.first[1] || z != r.first[2]) f((z * ny + y) * nx + x, 1u);
 }
 
 void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell) {
@@ -202,15 +348,20 @@ void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, con
         total += count;
       }
   items_.resize(total);
+  packed_.resize(total);
   // Scatter (offsets_ becomes the cursor): every box into its first cell,
   // then the straddlers into their others.
-  for (std::size_t i = 0; i < boxes.size(); ++i) items_[offsets_[firstCell_[i]]++] = static_cast<std::uint32_t>(i);
-  for (std::size_t k = 0; k < straddling_; ++k) {
-    const std::uint32_t id = straddlers_[k];
-    forEachOtherCell(straddlerRanges_[k], [&](std::uint64_t cell) { items_[offsets_[cell]++] = id; });
-  }
+  std::uint64_t* const cursor = offsets_.data();
+  std::uint32_t* const items = items_.data();
+  KeyBox* const packed = packed_.data();
+  const std::uint32_t* const firsts = firstCell_.data();
+  for (std::size_t i = 0; i < boxes.size(); ++i) items[cursor[firsts[i]]++] = static_cast<std::uint32_t>(i);
+  for (const Extra& e : std::span<const Extra>(extras_).first(extraCount_)) items[cursor[e.cell]++] = e.id;
+  // The boxes gathered in cell order: writing them in order is cheaper than
+  // scattering them with their indices (one cache line filled at a time).
+  for (std::uint64_t t = 0; t < total; ++t) packed[t] = boxes[items[t]];
   if (!onCell) return;
-  for (const Cell& cell : cells_) onCell(cell, {items_.data() + cell.begin, cell.count}, {});
+  for (const Cell& cell : cells_) onCell(cell, {items + cell.begin, cell.count}, {packed + cell.begin, cell.count});
 }
 
 }  // namespace bpaccel

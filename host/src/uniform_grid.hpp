@@ -19,10 +19,12 @@ namespace bpaccel {
 /// [lo, hi) that cover key space (the outer planes are 0 and 2^32), so the
 /// reference-point rule of BroadPhase holds exactly as on the tree.
 ///
-/// Cells are handed over with indices only (BroadPhase gathers their boxes):
-/// scattering the boxes too was measured slower per frame (bpaccel pairs
-/// --repeat, 8000 boxes): with the device simulated between frames their 24
-/// bytes a box land in cold cache lines, and a batch copies them again anyway.
+/// Then the boxes themselves (the device's layout) are gathered in cell
+/// order into one array that lives until the next build, and a batch refers
+/// to the cells' spans of it instead of copying every box into the batch
+/// (cellsOutliveBuild). Gathering in cell order was measured cheaper than
+/// scattering the boxes beside their indices (bpaccel pairs --repeat, 8000
+/// boxes): the writes fill one cache line at a time.
 ///
 /// Resolution: the planes are evenly spaced in float space (world units)
 /// between the scene's lowest box minimum and highest box maximum, since keys
@@ -34,17 +36,16 @@ namespace bpaccel {
 /// straddlers join, about what the tree's leaves hold (between cellSize/2
 /// and cellSize) once they have.
 ///
-/// A box's cell on an axis is looked up in a table over the scene's key
-/// range, one entry per bucket of 2^shift keys: cell = table[(key - keyLo)
-/// >> shift]. The table never decreases, so a cell's region is exactly the
-/// keys of its buckets, and each plane is the first key of a bucket: a box
-/// joins the cells from its min's to its max's, and any point inside it maps
-/// between them, with no float arithmetic on the way. Float arithmetic only
-/// places the planes: evenly in world units, each rounded up to a bucket
-/// boundary. Buckets are evenly spaced in key space, i.e. coarsest at the
-/// scene's largest magnitude; the shift makes a bucket there at most an
-/// eighth of a cell (at most kMaxBuckets buckets: beyond, cells snap to
-/// coarser steps, still exactly).
+/// A box's cell on an axis is computed, not looked up: cell(key) =
+/// clamp(trunc((value(key) / 2 - from / 2) * scale), 0, cells - 1) in float
+/// arithmetic, four keys at a time with SSE2 (value: the key's float,
+/// clamped to the finite ones; the halves keep the difference finite). Each
+/// step is monotone in the key (IEEE rounding is), so cell(key) never
+/// decreases and a cell's region is exactly the keys that map to it; its
+/// planes are found by a binary search over the keys with the same function.
+/// A box joins the cells from its min's to its max's, and any point inside it
+/// maps between them: exactness rests on monotonicity only, the float values
+/// only make the cells about even in world units.
 ///
 /// Bounds on memory: at most kMaxCellsPerAxis cells per axis and about
 /// ceil(2n / cellSize) cells in all (each axis's count rounded). Boxes large
@@ -65,6 +66,9 @@ class UniformGrid final : public Partition {
     if (fellBack_) return fallback_.items(cell);
     return {items_.data() + cell.begin, cell.count};
   }
+  /// The cells' boxes in the device's layout, like items(cell) (without a fallback).
+  std::span<const KeyBox> packed(const Cell& cell) const { return {packed_.data() + cell.begin, cell.count}; }
+  bool cellsOutliveBuild() const override { return !fellBack_; }
 
   /// Whether the last build gave the scene to the k-d tree (see above).
   bool fellBack() const { return fellBack_; }
@@ -73,46 +77,50 @@ class UniformGrid final : public Partition {
   /// Item entries the grid's buffers hold (their capacity).
   std::size_t storedItems() const {
     return items_.capacity() + offsets_.capacity() + firstCell_.capacity() +
-           straddlers_.capacity() + straddlerRanges_.capacity();
+           straddlers_.capacity() + straddlerRanges_.capacity() + extras_.capacity();
   }
+  /// Boxes the grid's packed copy holds (its capacity).
+  std::size_t storedBoxes() const { return packed_.capacity(); }
 
  private:
-  // One axis: the bucket table and the planes (planes[c] is the first key of
-  // cell c; planes[0] = 0, planes[cells] = 2^32).
+  // One axis: the cell function's constants and its planes (planes[c] is
+  // the first key of cell c; planes[0] = 0, planes[cells] = 2^32).
   struct Axis {
     std::vector<std::uint64_t> planes;
-    std::vector<std::uint16_t> table;  // cell of each bucket, never decreasing
-    std::uint32_t keyLo = 0;
-    unsigned shift = 0;
+    float fromHalf = 0, scale = 0, last = 0;  // half the lowest value, cells per half unit, cells - 1
+    std::uint32_t keyLo = 0, keyHi = 0;       // the scene's bounds on the axis
     std::uint32_t cells() const { return static_cast<std::uint32_t>(planes.size() - 1); }
-    // The cell of a key in [keyLo, keyHi] (every box's keys are).
-    struct Lookup {
-      const std::uint16_t* table;
-      std::uint64_t keyLo;
-      unsigned shift;
-      std::uint16_t cellOf(std::uint32_t key) const { return table[(key - keyLo) >> shift]; }
-    };
-    Lookup lookup() const { return {table.data(), keyLo, shift}; }
+    std::uint32_t cellOf(std::uint32_t key) const;
     void place(std::uint32_t keyLo, std::uint32_t keyHi, std::uint32_t cells);
   };
-  static constexpr std::uint64_t kMaxBuckets = 8192;
   struct Range {
     std::array<std::uint16_t, 3> first, last;  // cells per axis (at most kMaxCellsPerAxis)
   };
   // Counts each cell's boxes into offsets_; false when the boxes would join too many cells.
   bool countBoxes(std::span<const KeyBox> boxes);
   void chooseResolution(std::span<const KeyBox> boxes, std::size_t cellSize);
-  // Calls f(cell) for each cell of r but its first.
+  // Calls f(cell, 1) for each cell of r but its first: branch-free when r
+  // spans at most two cells an axis (boxes smaller than cells, nearly every
+  // straddler), with f(any number, 0) for each of the seven neighbours the
+  // box misses; else by loops.
   template <typename F>
   void forEachOtherCell(const Range& r, F&& f) const;
+  // A straddler's entry in one of its other cells.
+  struct Extra {
+    std::uint64_t cell;
+    std::uint32_t id;
+  };
 
   std::array<Axis, 3> axes_;
   std::vector<std::uint32_t> firstCell_;  // each box's first cell (its min corner's)
   std::vector<std::uint32_t> straddlers_;  // boxes in more than one cell, with their ranges
   std::vector<Range> straddlerRanges_;
   std::size_t straddling_ = 0;            // how many of those two hold this frame's straddlers
+  std::vector<Extra> extras_;             // the straddlers' entries in their other cells
+  std::size_t extraCount_ = 0;            // how many of those this frame holds
   std::vector<std::uint64_t> offsets_;   // per cell: its count, then its first item, then the scatter cursor
   std::vector<std::uint32_t> items_;     // the cells' item lists, in cell order
+  std::vector<KeyBox> packed_;           // their boxes, in the same order
   std::vector<Cell> cells_;
   KdTree fallback_;
   bool fellBack_ = false;

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "keys.hpp"
@@ -71,4 +72,37 @@ TEST(ToKeys, AcceptsInfinitiesAndZeroExtent) {
 TEST(CheckObjectCount, RejectsMoreObjectsThanIndicesCanAddress) {
   EXPECT_NO_THROW(checkObjectCount(kMaxObjects));
   EXPECT_THROW(checkObjectCount(kMaxObjects + 1), InputError);
+}
+
+// The conversion works on several boxes at once: a bad field is found at
+// every position within a group and on every axis, and named.
+TEST(ToKeys, RejectsEveryBadFieldAtEveryPositionOfAGroupOfBoxes) {
+  for (std::size_t n : {1u, 2u, 3u, 4u, 5u}) {
+    for (std::size_t at = 0; at < n; ++at) {
+      for (int a = 0; a < 3; ++a) {
+        for (int kind = 0; kind < 3; ++kind) {  // NaN min, NaN max, min above max
+          std::vector<Aabb> boxes(n, Aabb{{-1, -2, -3}, {1, 2, 3}});
+          if (kind == 0) boxes[at].min[a] = std::nanf("");
+          if (kind == 1) boxes[at].max[a] = -std::nanf("");
+          if (kind == 2) boxes[at].min[a] = boxes[at].max[a] + 0.5f;
+          std::vector<KeyBox> keys;
+          const std::string what = "n " + std::to_string(n) + " box " + std::to_string(at) + " axis " +
+                                   std::to_string(a) + " kind " + std::to_string(kind);
+          try {
+            toKeys(boxes, keys);
+            ADD_FAILURE() << "accepted: " << what;
+          } catch (const InputError& e) {
+            EXPECT_EQ(e.object(), at) << what;
+            const std::string axis = std::string("axis ") + "xyz"[a];
+            EXPECT_NE(std::string(e.what()).find(axis), std::string::npos) << what << ": " << e.what();
+          }
+        }
+      }
+    }
+  }
+  // Touching and zero-extent boxes, and -0.0 against +0.0, are fine.
+  std::vector<Aabb> good(5, Aabb{{-0.0f, 0, 1}, {0.0f, 0, 1}});
+  std::vector<KeyBox> keys;
+  EXPECT_NO_THROW(toKeys(good, keys));
+  EXPECT_EQ(keys[3].min[0], keys[3].max[0]);
 }

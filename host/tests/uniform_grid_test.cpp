@@ -99,16 +99,23 @@ TEST(UniformGrid, CellsPartitionKeySpaceAndHoldEveryBoxTheyTouch) {
     for (std::size_t cell : {2u, 16u, 64u}) {
       UniformGrid grid;
       std::size_t handed = 0;
-      bool sameItems = true;
-      grid.build(keys, cell, [&](const Cell& c, auto items, auto) {
+      bool sameItems = true, packedAreTheItemsBoxes = true;
+      grid.build(keys, cell, [&](const Cell& c, auto items, auto packed) {
         sameItems = sameItems && grid.cells().at(handed).begin == c.begin &&
                     std::equal(items.begin(), items.end(), grid.items(c).begin(), grid.items(c).end());
+        if (grid.fellBack()) return;
+        packedAreTheItemsBoxes = packedAreTheItemsBoxes && packed.size() == items.size() &&
+                                 packed.data() == grid.packed(c).data();
+        for (std::size_t t = 0; packedAreTheItemsBoxes && t < items.size(); ++t)
+          packedAreTheItemsBoxes = packed[t].min == keys[items[t]].min && packed[t].max == keys[items[t]].max;
         ++handed;
       });
       const std::string label = name + " cell " + std::to_string(cell);
       if (grid.fellBack()) continue;  // the tree's own tests cover its cells
       ++gridded;
       EXPECT_TRUE(sameItems) << label << ": cells are handed over as the grid keeps them, in order";
+      EXPECT_TRUE(packedAreTheItemsBoxes) << label << ": each cell's packed boxes are its items' boxes, in order";
+      EXPECT_TRUE(grid.cellsOutliveBuild()) << label;
       EXPECT_EQ(handed, grid.cells().size()) << label;
       expectCellsPartitionSpaceAndHoldExactlyTheirBoxes(grid, keys, label);
     }
@@ -131,6 +138,7 @@ TEST(UniformGrid, AimsAtTwoNOverCellSizeCellsOnAUniformScene) {
     EXPECT_LE(r[0], r[1] + 1) << "a cubic scene gets cubic cells";
     EXPECT_LE(r[1], r[0] + 1);
     EXPECT_LE(grid.storedItems(), 3 * UniformGrid::kMaxEntriesPerBox * keys.size());
+    EXPECT_LE(grid.storedBoxes(), UniformGrid::kMaxEntriesPerBox * keys.size());
   }
 }
 
@@ -191,6 +199,8 @@ TEST(UniformGrid, DegenerateScenesStayExactAndBounded) {
   EXPECT_TRUE(gridOf(bp).fellBack());
   EXPECT_EQ(sorted(pairs), bruteForce(manyHuge));
   EXPECT_LE(gridOf(bp).storedItems(), 3 * UniformGrid::kMaxEntriesPerBox * manyHuge.size());
+  EXPECT_LE(gridOf(bp).storedBoxes(), UniformGrid::kMaxEntriesPerBox * manyHuge.size());
+  EXPECT_FALSE(bp.partition().cellsOutliveBuild()) << "the tree's cells live during the call only";
 
   // A flat scene: one axis has almost no extent, and the cell count stays near the target.
   std::vector<Aabb> flat = scatteredBoxes(4000, 9, -100, 100, 0.1f, 1);
