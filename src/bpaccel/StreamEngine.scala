@@ -231,10 +231,17 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // between the issue and the enables of the A registers.
   val blockEnd     = Reg(Bool()) // left == 0
   val hasNextBlock = Reg(Bool()) // blockLeft >= m
-  val blockEndNext     = WireDefault(blockEnd)
-  val hasNextBlockNext = WireDefault(hasNextBlock)
+  // `*Carry`: the next value unless a start is accepted. The look-ahead of
+  // aLoad reads these: a start is accepted only while no run is active, so
+  // its issue term is false then anyway, and the start count's compares stay
+  // out of it (stream m = 32's critical path after the launch's).
+  val blockEndCarry     = WireDefault(blockEnd)
+  val hasNextBlockCarry = WireDefault(hasNextBlock)
+  val blockEndNext      = WireDefault(blockEndCarry)
+  val hasNextBlockNext  = WireDefault(hasNextBlockCarry)
   blockEnd     := blockEndNext
   hasNextBlock := hasNextBlockNext
+  assert(!io.prepare.valid || !(starting || issuing), "a start was accepted while a run was active")
   // Their next values, in turn, from flags kept a step ahead of the counters,
   // so that no comparison sits in the enables' look-ahead either (the path
   // advance -> issue -> blockEndNext -> aLoad's copies, stream m = 32).
@@ -248,7 +255,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // The A block is copied from aNext through the startup and at each block change.
   val aLoad = replicatedEnable(
     "aLoad",
-    next = startingSoon || (issuingNext && io.room && blockEndNext && hasNextBlockNext),
+    next = startingSoon || (issuingNext && io.room && blockEndCarry && hasNextBlockCarry),
     now = starting || (issue && blockEnd && hasNextBlock)
   )
   for (k <- 0 until m) when(aLoad(k)) { a(k) := aNext(k) }
@@ -266,7 +273,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       s        := s + 1.U
       left     := left - 1.U
       leftIsOne := left === 2.U
-      blockEndNext := leftIsOne
+      blockEndCarry := leftIsOne
       capture  := (capture << 1)(m - 1, 0)
     }.elsewhen(hasNextBlock) {
       base         := base + m.U
@@ -276,8 +283,8 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       leftIsOne          := blockLeft === (m + 1).U
       blockLeftIsM       := blockLeft === (2 * m).U
       blockLeftAtLeast2m := blockLeft >= (3 * m).U
-      blockEndNext     := blockLeftIsM
-      hasNextBlockNext := blockLeftAtLeast2m
+      blockEndCarry     := blockLeftIsM
+      hasNextBlockCarry := blockLeftAtLeast2m
       capture      := 1.U
     }.otherwise {
       issuingNext := false.B
