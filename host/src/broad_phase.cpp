@@ -128,15 +128,23 @@ void BroadPhase::check() const {
 
 void BroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) {
   const auto t0 = Clock::now();
-  toKeys(boxes, keys_);
+  // The bounds in the same pass when the partition will use them (timed as conversion).
+  const bool withBounds = cellSize_ && partition_->needsBounds();
+  KeyBounds bounds;
+  if (withBounds)
+    toKeys(boxes, keys_, bounds);
+  else
+    toKeys(boxes, keys_);
   const double convert = seconds(t0, Clock::now());
-  findPairs(std::span<const KeyBox>(keys_), out);
+  findKeyPairs(std::span<const KeyBox>(keys_), out, withBounds ? &bounds : nullptr);
   times_.convertSeconds = convert;
   times_.totalSeconds += convert;
   for (RunRecord& r : runs_) r.readySeconds += convert;  // the conversion came first
 }
 
-void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out) {
+void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out) { findKeyPairs(keys, out, nullptr); }
+
+void BroadPhase::findKeyPairs(std::span<const KeyBox> keys, std::vector<Pair>& out, const KeyBounds* bounds) {
   checkObjectCount(keys.size());
   out.clear();
   stats_ = {};
@@ -150,9 +158,9 @@ void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out)
     workers_.front()->flush();
     times_.cellsSeconds = seconds(t0, Clock::now());
   } else if (!pool_) {
-    streamCells(keys);
+    streamCells(keys, bounds);
   } else {
-    streamCellsToThreads(keys);
+    streamCellsToThreads(keys, bounds);
   }
   finishCells(out);
   times_.totalSeconds = times_.partitionSeconds + times_.cellsSeconds;
@@ -160,7 +168,7 @@ void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out)
 
 // Each cell goes to the backend as soon as the partition has made it (with
 // the tree, the first run is ready long before the tree is finished).
-void BroadPhase::streamCells(std::span<const KeyBox> keys) {
+void BroadPhase::streamCells(std::span<const KeyBox> keys, const KeyBounds* bounds) {
   const auto t0 = Clock::now();
   Worker& w = *workers_.front();
   double inCells = 0;
@@ -169,7 +177,7 @@ void BroadPhase::streamCells(std::span<const KeyBox> keys) {
     const auto c0 = Clock::now();
     w.processCell(keys, items, packed, &leaf, capacity_, partition_->cellsOutliveBuild());
     inCells += seconds(c0, Clock::now());
-  });
+  }, bounds);
   const auto f0 = Clock::now();
   w.flush();  // the last, partly filled batch
   inCells += seconds(f0, Clock::now());
@@ -181,7 +189,7 @@ void BroadPhase::streamCells(std::span<const KeyBox> keys) {
 // a task while it goes on; the other threads process cells meanwhile, and the
 // builder joins them when the partition is done. A task gets its own copy of
 // the cell's items and boxes: the tree's storage changes as the build goes on.
-void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys) {
+void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys, const KeyBounds* bounds) {
   const auto t0 = Clock::now();
   Clock::time_point built;
   pool_->run([&] {
@@ -199,7 +207,7 @@ void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys) {
         Worker& w = *workers_.at(static_cast<std::size_t>(tbb::this_task_arena::current_thread_index()));
         w.processCell(keys, copy.items, copy.packed, &leaf, capacity_, false);
       });
-    });
+    }, bounds);
     built = Clock::now();
     tasks.wait();
     // Each worker's last, partly filled batch; no task runs any more, so

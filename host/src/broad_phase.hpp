@@ -82,8 +82,12 @@ class BroadPhase {
  private:
   struct Worker;
   class Pool;
-  void streamCells(std::span<const KeyBox> keys);           // one thread: partition and cells interleaved
-  void streamCellsToThreads(std::span<const KeyBox> keys);  // the pool: cells as tasks while the partition goes on
+  // `bounds`: the keys' bounds when the conversion found them, else null.
+  void findKeyPairs(std::span<const KeyBox> keys, std::vector<Pair>& out, const KeyBounds* bounds);
+  // One thread: partition and cells interleaved.
+  void streamCells(std::span<const KeyBox> keys, const KeyBounds* bounds);
+  // The pool: cells as tasks while the partition goes on.
+  void streamCellsToThreads(std::span<const KeyBox> keys, const KeyBounds* bounds);
   void startCells(std::chrono::steady_clock::time_point frameStart);  // clears the workers' results
   void finishCells(std::vector<Pair>& out);                            // gathers them
   void check() const;

@@ -43,7 +43,9 @@ class KdTree final : public Partition {
   enum class Layout { Auto, Carried, Gathered };
   static constexpr std::size_t kCarryAbove = 1 << 18;  // 6.3 MB of boxes
   void build(std::span<const KeyBox> boxes, std::size_t cellSize, const LeafSink& onLeaf, Layout layout);
-  void build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell) override {
+  // The tree splits at medians and needs no bounds.
+  void build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell,
+             const KeyBounds* = nullptr) override {
     build(boxes, cellSize, onCell, Layout::Auto);
   }
   std::string_view name() const override { return "k-d"; }

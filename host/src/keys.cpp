@@ -1,5 +1,7 @@
 #include "keys.hpp"
 
+#include <algorithm>
+#include <array>
 #include <bit>
 
 #if defined(__x86_64__)
@@ -71,11 +73,52 @@ bool isBad(const Aabb& b, const KeyBox& k) {
 }
 
 #if defined(__x86_64__)
+// The bounds of boxes two at a time (three vectors of keys): each word
+// becomes t = key ^ flip, flip being the sign bit for a min word and its
+// complement for a max word, so that t in signed order (SSE2 compares only
+// signed and has no 32-bit min) orders mins as keys and maxes in reverse; one
+// running least per lane then holds the lowest min or the highest max.
+class BoundsSse2 {
+ public:
+  void add(const __m128i (&keys)[3]) {
+    for (int v = 0; v < 3; ++v) {
+      const __m128i t = _mm_xor_si128(keys[v], flip_[v]);
+      const __m128i lower = _mm_cmpgt_epi32(least_[v], t);
+      least_[v] = _mm_or_si128(_mm_and_si128(lower, t), _mm_andnot_si128(lower, least_[v]));
+    }
+  }
+  void mergeInto(KeyBounds& bounds) const {
+    for (int v = 0; v < 3; ++v) {
+      alignas(16) std::array<std::uint32_t, 4> k;
+      _mm_store_si128(reinterpret_cast<__m128i*>(k.data()), _mm_xor_si128(least_[v], flip_[v]));
+      for (int lane = 0; lane < 4; ++lane) {
+        const int word = 4 * v + lane, axis = word % 3;  // words 0-2 and 6-8 of the twelve are mins
+        if (word % 6 < 3)
+          bounds.lo[axis] = std::min(bounds.lo[axis], k[lane]);
+        else
+          bounds.hi[axis] = std::max(bounds.hi[axis], k[lane]);
+      }
+    }
+  }
+
+ private:
+  static constexpr int kMinFlip = static_cast<int>(kSignBit), kMaxFlip = static_cast<int>(~kSignBit);
+  const __m128i flip_[3] = {_mm_setr_epi32(kMinFlip, kMinFlip, kMinFlip, kMaxFlip),
+                            _mm_setr_epi32(kMaxFlip, kMaxFlip, kMinFlip, kMinFlip),
+                            _mm_setr_epi32(kMinFlip, kMaxFlip, kMaxFlip, kMaxFlip)};
+  // Flipped back, the start is ~0 in min lanes and 0 in max lanes: no bound yet.
+  __m128i least_[3] = {_mm_set1_epi32(kMaxFlip), _mm_set1_epi32(kMaxFlip), _mm_set1_epi32(kMaxFlip)};
+};
+
 // Two boxes (12 words, 3 vectors) a step with SSE2, the baseline of x86-64:
 // keyOfBits and isNaNBits lane by lane, and min > max by comparing each min
 // word with the word three further on. Returns the index of the first box
-// left to the scalar loop; `bad` collects any bad lane.
-std::size_t toKeysSse2(std::span<const Aabb> boxes, std::vector<KeyBox>& out, bool& bad) {
+// left to the scalar loop; `bad` collects any bad lane, `bounds` (with
+// kBounds) the keys' bounds. The lanes' bounds are a local, so they stay in
+// registers: the stores to `out` could alias anything reached by pointer.
+template <bool kBounds>
+std::size_t toKeysSse2(std::span<const Aabb> boxes, std::vector<KeyBox>& out, bool& bad, KeyBounds* bounds) {
+  BoundsSse2 lanes;
   static_assert(sizeof(Aabb) == 24 && sizeof(KeyBox) == 24, "two boxes are three 16-byte vectors");
   const __m128i signBit = _mm_set1_epi32(static_cast<int>(kSignBit));
   const __m128i magnitude = _mm_set1_epi32(static_cast<int>(~kSignBit));
@@ -98,6 +141,7 @@ std::size_t toKeysSse2(std::span<const Aabb> boxes, std::vector<KeyBox>& out, bo
       k[v] = key(w[v]);
       _mm_storeu_si128(reinterpret_cast<__m128i*>(to + 24 * i + 16 * v), k[v]);
     }
+    if constexpr (kBounds) lanes.add(k);
     // Words 3-6, 7-10 and 11: the max beside each min lane.
     const __m128i above[3] = {_mm_or_si128(_mm_srli_si128(k[0], 12), _mm_slli_si128(k[1], 4)),
                               _mm_or_si128(_mm_srli_si128(k[1], 12), _mm_slli_si128(k[2], 4)),
@@ -109,13 +153,21 @@ std::size_t toKeysSse2(std::span<const Aabb> boxes, std::vector<KeyBox>& out, bo
     }
   }
   bad |= _mm_movemask_epi8(flags) != 0;
+  if constexpr (kBounds) lanes.mergeInto(*bounds);
   return i;
 }
 #endif
 
-}  // namespace
+void addBox(const KeyBox& k, KeyBounds& bounds) {
+  for (int a = 0; a < 3; ++a) {
+    bounds.lo[a] = std::min(bounds.lo[a], k.min[a]);
+    bounds.hi[a] = std::max(bounds.hi[a], k.max[a]);
+  }
+}
 
-void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out) {
+// toKeys, with the bounds when `bounds` is given (a loop of its own each, so
+// the common call without them pays nothing).
+void convert(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds* bounds) {
   checkObjectCount(boxes.size());
   out.resize(boxes.size());
   // Branch-free passes that convert and only accumulate a flag; the rare bad
@@ -123,7 +175,7 @@ void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out) {
   bool bad = false;
   std::size_t first = 0;
 #if defined(__x86_64__)
-  first = toKeysSse2(boxes, out, bad);
+  first = bounds ? toKeysSse2<true>(boxes, out, bad, bounds) : toKeysSse2<false>(boxes, out, bad, nullptr);
 #endif
   for (std::size_t i = first; i < boxes.size(); ++i) {
     const Aabb& b = boxes[i];
@@ -133,9 +185,36 @@ void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out) {
       k.max[a] = keyOfBits(std::bit_cast<std::uint32_t>(b.max[a]));
     }
     bad |= isBad(b, k);
+    if (bounds) addBox(k, *bounds);
   }
   if (bad) [[unlikely]]
     throwFirstBad(boxes, out);
+}
+
+}  // namespace
+
+void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out) { convert(boxes, out, nullptr); }
+
+void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds& bounds) {
+  bounds = {};
+  convert(boxes, out, &bounds);
+}
+
+KeyBounds boundsOf(std::span<const KeyBox> boxes) {
+  KeyBounds bounds;
+  std::size_t i = 0;
+#if defined(__x86_64__)
+  BoundsSse2 lanes;
+  const auto* words = reinterpret_cast<const char*>(boxes.data());
+  for (; i + 2 <= boxes.size(); i += 2) {
+    __m128i k[3];
+    for (int v = 0; v < 3; ++v) k[v] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(words + 24 * i + 16 * v));
+    lanes.add(k);
+  }
+  lanes.mergeInto(bounds);
+#endif
+  for (; i < boxes.size(); ++i) addBox(boxes[i], bounds);
+  return bounds;
 }
 
 }  // namespace bpaccel

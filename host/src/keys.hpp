@@ -33,6 +33,12 @@ constexpr std::uint64_t kMaxObjects = 0xFFFFFFFFull;
 /// and converts it to keys. Throws InputError for the first bad box; `out` is
 /// reused across calls to avoid allocation.
 void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out);
+/// The same, and the scene's bounds found in the same pass (a partition that
+/// needs them then skips a pass of its own over the keys).
+void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds& bounds);
+
+/// The bounds of boxes already converted.
+KeyBounds boundsOf(std::span<const KeyBox> boxes);
 
 /// Throws InputError when `count` objects cannot be indexed.
 void checkObjectCount(std::uint64_t count);

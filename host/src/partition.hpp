@@ -46,8 +46,13 @@ class Partition {
   /// Partitions `boxes` into cells of about `cellSize` boxes (what "about"
   /// means is each kind's own rule) and hands each cell to `onCell` (if any).
   /// A cell may hold more than cellSize boxes; BroadPhase chunks cells
-  /// above the backend's capacity.
-  virtual void build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell) = 0;
+  /// above the backend's capacity. `bounds`: the boxes' bounds when the
+  /// caller has them already (toKeys finds them while converting), else a
+  /// kind that needs them finds them itself.
+  virtual void build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell,
+                     const KeyBounds* bounds = nullptr) = 0;
+  /// Whether build uses the boxes' bounds (then a caller that has them hands them over).
+  virtual bool needsBounds() const { return false; }
   /// The last build's cells, in the order they were handed over.
   virtual const std::vector<Cell>& cells() const = 0;
   /// Box indices of a cell of the last build.

@@ -19,6 +19,13 @@ struct KeyBox {
   std::array<std::uint32_t, 3> max;
 };
 
+/// A scene's bounds in keys: the lowest min and the highest max per axis
+/// (for no boxes, lo above hi).
+struct KeyBounds {
+  std::array<std::uint32_t, 3> lo{~0u, ~0u, ~0u};
+  std::array<std::uint32_t, 3> hi{0, 0, 0};
+};
+
 /// Inclusive overlap on every axis: boxes that touch overlap (Bullet's rule).
 inline bool overlaps(const KeyBox& a, const KeyBox& b) {
   return a.min[0] <= b.max[0] && b.min[0] <= a.max[0] &&  //

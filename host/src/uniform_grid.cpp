@@ -99,58 +99,8 @@ void UniformGrid::Axis::place(std::uint32_t lo, std::uint32_t hi, std::uint32_t 
   planes.push_back(kTop);
 }
 
-namespace {
-
-// The scene's bounds: the lowest min and the highest max per axis.
-void bounds(std::span<const KeyBox> boxes, std::array<std::uint32_t, 3>& lo, std::array<std::uint32_t, 3>& hi) {
-  lo = {~0u, ~0u, ~0u};
-  hi = {0, 0, 0};
-  std::size_t i = 0;
-#if defined(__x86_64__)
-  // Two boxes (three vectors) a step; every lane keeps both its least and its
-  // greatest key, and the lanes that hold mins and maxes are read at the end.
-  // Keys with the sign bit flipped order as SSE2's signed integers.
-  const __m128i sign = _mm_set1_epi32(static_cast<int>(0x80000000u));
-  __m128i least[3], greatest[3];
-  for (int v = 0; v < 3; ++v) {
-    least[v] = _mm_set1_epi32(std::numeric_limits<std::int32_t>::max());
-    greatest[v] = _mm_set1_epi32(std::numeric_limits<std::int32_t>::min());
-  }
-  const auto* words = reinterpret_cast<const char*>(boxes.data());
-  for (; i + 2 <= boxes.size(); i += 2)
-    for (int v = 0; v < 3; ++v) {
-      const __m128i k =
-          _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(words + 24 * i + 16 * v)), sign);
-      const __m128i lower = _mm_cmpgt_epi32(least[v], k), higher = _mm_cmpgt_epi32(k, greatest[v]);
-      least[v] = _mm_or_si128(_mm_and_si128(lower, k), _mm_andnot_si128(lower, least[v]));
-      greatest[v] = _mm_or_si128(_mm_and_si128(higher, k), _mm_andnot_si128(higher, greatest[v]));
-    }
-  for (int v = 0; v < 3; ++v) {
-    alignas(16) std::array<std::uint32_t, 4> l, g;
-    _mm_store_si128(reinterpret_cast<__m128i*>(l.data()), _mm_xor_si128(least[v], sign));
-    _mm_store_si128(reinterpret_cast<__m128i*>(g.data()), _mm_xor_si128(greatest[v], sign));
-    for (int lane = 0; lane < 4; ++lane) {
-      const int word = 4 * v + lane, axis = word % 3;  // words 0-2 and 6-8 of the twelve are mins
-      if (word % 6 < 3)
-        lo[axis] = std::min(lo[axis], l[lane]);
-      else
-        hi[axis] = std::max(hi[axis], g[lane]);
-    }
-  }
-#endif
-  for (; i < boxes.size(); ++i)
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], boxes[i].min[a]);
-      hi[a] = std::max(hi[a], boxes[i].max[a]);
-    }
-}
-
-}  // namespace
-
-void UniformGrid::chooseResolution(std::span<const KeyBox> boxes, std::size_t cellSize) {
-  std::array<std::uint32_t, 3> lo, hi;
-  bounds(boxes, lo, hi);
-  if (boxes.empty()) lo = hi;
+void UniformGrid::chooseResolution(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds& bounds) {
+  const std::array<std::uint32_t, 3> hi = bounds.hi, lo = boxes.empty() ? hi : bounds.lo;
   // ceil(2n / cellSize) cells (at most 2n, so memory stays linear in n).
   const double target = std::ceil(2.0 * static_cast<double>(boxes.size()) / static_cast<double>(cellSize));
   std::array<double, 3> extent{};
@@ -319,11 +269,12 @@ void UniformGrid::forEachOtherCell(const Range& r, F&& f) const {
         if (x != r.first[0] || y != r.first[1] || z != r.first[2]) f((z * ny + y) * nx + x, 1u);
 }
 
-void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell) {
+void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell,
+                        const KeyBounds* bounds) {
   checkObjectCount(boxes.size());
   if (cellSize < 1) cellSize = 1;
   cells_.clear();
-  chooseResolution(boxes, cellSize);
+  chooseResolution(boxes, cellSize, bounds ? *bounds : boundsOf(boxes));
   const std::uint32_t nx = axes_[0].cells(), ny = axes_[1].cells(), nz = axes_[2].cells();
   const std::size_t cellCount = std::size_t{nx} * ny * nz;
   offsets_.assign(cellCount, 0);

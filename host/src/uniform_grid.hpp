@@ -59,8 +59,10 @@ class UniformGrid final : public Partition {
   static constexpr std::uint64_t kMaxEntriesPerBox = 4;
   static constexpr std::uint32_t kMaxCellsPerAxis = 1024;
 
-  void build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell) override;
+  void build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell,
+             const KeyBounds* bounds = nullptr) override;
   std::string_view name() const override { return "grid"; }
+  bool needsBounds() const override { return true; }
   const std::vector<Cell>& cells() const override { return fellBack_ ? fallback_.cells() : cells_; }
   std::span<const std::uint32_t> items(const Cell& cell) const override {
     if (fellBack_) return fallback_.items(cell);
@@ -98,7 +100,7 @@ class UniformGrid final : public Partition {
   };
   // Counts each cell's boxes into offsets_; false when the boxes would join too many cells.
   bool countBoxes(std::span<const KeyBox> boxes);
-  void chooseResolution(std::span<const KeyBox> boxes, std::size_t cellSize);
+  void chooseResolution(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds& bounds);
   // Calls f(cell, 1) for each cell of r but its first: branch-free when r
   // spans at most two cells an axis (boxes smaller than cells, nearly every
   // straddler), with f(any number, 0) for each of the seven neighbours the

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -105,4 +106,36 @@ TEST(ToKeys, RejectsEveryBadFieldAtEveryPositionOfAGroupOfBoxes) {
   std::vector<KeyBox> keys;
   EXPECT_NO_THROW(toKeys(good, keys));
   EXPECT_EQ(keys[3].min[0], keys[3].max[0]);
+}
+
+// The bounds found while converting are each axis's lowest min and highest
+// max, computed here one box at a time, for every count up to nine (the
+// vector loop's pairs and the scalar tail) and for random signs and sizes.
+TEST(ToKeys, FindsTheLowestMinAndHighestMaxOfEveryAxisWhileConverting) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> coordinate(-1e6f, 1e6f), size(0.0f, 1e3f);
+  for (int trial = 0; trial < 50; ++trial) {
+    for (std::size_t n = 0; n <= 9; ++n) {
+      std::vector<Aabb> boxes(n);
+      for (Aabb& b : boxes)
+        for (int a = 0; a < 3; ++a) {
+          b.min[a] = coordinate(rng);
+          b.max[a] = b.min[a] + size(rng);
+        }
+      std::vector<KeyBox> keys;
+      KeyBounds bounds;
+      toKeys(boxes, keys, bounds);
+      KeyBounds expected;
+      for (const KeyBox& k : keys)
+        for (int a = 0; a < 3; ++a) {
+          expected.lo[a] = std::min(expected.lo[a], k.min[a]);
+          expected.hi[a] = std::max(expected.hi[a], k.max[a]);
+        }
+      EXPECT_EQ(bounds.lo, expected.lo) << n << " boxes";
+      EXPECT_EQ(bounds.hi, expected.hi) << n << " boxes";
+      const KeyBounds again = boundsOf(keys);
+      EXPECT_EQ(again.lo, expected.lo) << n << " boxes";
+      EXPECT_EQ(again.hi, expected.hi) << n << " boxes";
+    }
+  }
 }
