@@ -18,13 +18,16 @@ constexpr std::uint64_t kTop = std::uint64_t{1} << 32;
 constexpr std::uint32_t kLowestFinite = 0x00800000u;   // floatToKey(-FLT_MAX)
 constexpr std::uint32_t kHighestFinite = 0xFF7FFFFFu;  // floatToKey(FLT_MAX)
 
-// The float of a key (floatToKey's inverse) as a double, clamped to the
-// finite floats (keys beyond them: the infinities and NaN bit patterns, which
-// the KeyBox API lets through). Places planes only.
-double valueOf(std::uint32_t key) {
+// The float of a key (floatToKey's inverse), clamped to the finite floats
+// (keys beyond them: the infinities and NaN bit patterns, which the KeyBox
+// API lets through).
+float finiteValueOf(std::uint32_t key) {
   key = std::clamp(key, kLowestFinite, kHighestFinite);
-  return static_cast<double>(std::bit_cast<float>(key & 0x80000000u ? key & 0x7FFFFFFFu : ~key));
+  return std::bit_cast<float>(key & 0x80000000u ? key & 0x7FFFFFFFu : ~key);
 }
+
+// The same as a double; places planes only.
+double valueOf(std::uint32_t key) { return static_cast<double>(finiteValueOf(key)); }
 
 #if defined(__x86_64__)
 // The cell function (see UniformGrid) on four keys, each lane with its own
@@ -66,8 +69,7 @@ std::uint32_t UniformGrid::Axis::cellOf(std::uint32_t key) const {
                                                                _mm_set1_ps(fromHalf), _mm_set1_ps(scale),
                                                                _mm_set1_ps(last))));
 #else
-  key = std::clamp(key, kLowestFinite, kHighestFinite);
-  const float value = std::bit_cast<float>(key & 0x80000000u ? key & 0x7FFFFFFFu : ~key);
+  const float value = finiteValueOf(key);
   return static_cast<std::uint32_t>(std::min(std::max((value * 0.5f - fromHalf) * scale, 0.0f), last));
 #endif
 }
