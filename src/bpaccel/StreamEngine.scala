@@ -62,7 +62,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // Registered flags only in front of the window's enables (192m flip-flops).
   val filling = RegInit(false.B) // starting and window shifts still needed
   val issue   = issuing && advance
-  val fill    = filling
 
   // The next values of the flags behind the wide enables (window, A block):
   // the enables are computed from them a cycle ahead, see `replicatedEnable`.
@@ -203,7 +202,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     "windowShift",
     next = (io.write.valid && takesLoadsNext) || fillingSoon ||
       (issuingNext && (io.room || p.has(Fault.LookaheadIgnoresRoom).B)),
-    now = loadShift || fill || issue
+    now = loadShift || filling || issue
   )
   for (k <- 0 until m) when(windowShift(k)) { window(k) := (if (k == m - 1) entry else window(k + 1)) }
 
@@ -320,7 +319,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     rObj  := Mux(longBlock, (m + 1).U, 0.U)
     rLeft := Mux(longBlock, count - (m + 2).U, 0.U)
     rBlockEnd     := !longBlock || count === (m + 2).U
-    rHasNextBlock := count >= (m + 2).U // rBlockLeft = count-2 >= m
+    rHasNextBlock := longBlock // rBlockLeft = count-2 >= m
   }
   when(io.launch.valid) { readCredits := readDepth.U }
 
