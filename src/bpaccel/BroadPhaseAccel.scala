@@ -83,10 +83,20 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   engine.io.prepare.valid := start.fire
   engine.io.prepare.bits  := start.bits
   engine.io.launch  := control.io.launch
-  // Credits, registered in the engine so that no adder sits before its
-  // enables: queue count + cycles in flight grows by at most one a cycle, so
-  // room for one more now means room in the next cycle.
-  engine.io.room := queue.io.count +& engine.io.activity.inFlight +& 1.U < creditedEntries.U
+  // Credits: result-queue entries neither occupied nor claimed by a cycle in
+  // flight. They are kept in a register, because the check computed from the
+  // queue's pointers (count + in flight + 1 < depth) sat in front of the
+  // engine's enable look-ahead (stream m = 32's critical path, 98.1 MHz).
+  // Occupied + claimed grows by at most one a cycle, so two credits now mean
+  // room for one more issue in the next cycle.
+  val credits = RegInit(creditedEntries.U(log2Ceil(creditedEntries + 1).W))
+  credits := credits - engine.io.activity.issued.asUInt + engine.io.activity.retired.asUInt -
+    queue.io.enq.fire.asUInt + queue.io.deq.fire.asUInt
+  assert(
+    credits === creditedEntries.U -& queue.io.count -& engine.io.activity.inFlight,
+    "the result queue's credits do not match its count and the cycles in flight"
+  )
+  engine.io.room := credits >= 2.U
   control.io.engine := engine.io.activity
 
   val beat = engine.io.out

@@ -9,6 +9,7 @@ class EngineActivity(p: AccelParams) extends Bundle {
   val issued   = Bool() // a schedule cycle was issued
   val stalled  = Bool() // a schedule cycle was ready but the result queue had no room
   val inFlight = UInt(log2Ceil(p.pipelineLatency + 1).W) // issued cycles not yet at the result queue
+  val retired  = Bool() // an issued cycle leaves the pipeline (the last stage is valid)
 }
 
 /** Starts runs, decodes their errors, ends them, and keeps the counters.

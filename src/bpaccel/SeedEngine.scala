@@ -127,6 +127,7 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   io.activity.issued   := issue.valid
   io.activity.stalled  := sequencer.io.active && !issue.valid
   io.activity.inFlight := PopCount(stages.map(_.valid))
+  io.activity.retired  := stages.last.valid
 
   emit(atCompare.valid, atCompare.bits.iBase, atCompare.bits.jBase, atCompare.bits.laneMask, probeI, atCompare.bits.probeJ, hitMask)
 }
