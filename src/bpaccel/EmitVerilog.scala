@@ -53,6 +53,8 @@ object EmitVerilog {
     )
     // One clock port per memory, so each maps to block RAM when synthesised on its own.
     SingleClockMemories.rewrite(targetDir)
+    // No read meets a write at the same row, so the block RAM needs no collision bypass.
+    NoCollisionMemories.rewrite(targetDir)
     Files.writeString(targetDir.resolve("bpaccel_params.h"), CHeader(p))
     Files.writeString(targetDir.resolve(lintWaivers), lintWaiverText)
     targetDir.resolve("filelist.f")

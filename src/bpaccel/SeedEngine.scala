@@ -50,6 +50,16 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
     VecInit(Seq.tabulate(m)(k => io.write.valid && io.write.bits.row === 0.U && io.write.bits.lane === k.U)).asUInt,
     0.U(m.W)
   )
+  // readsNeverMeetWrites: no read whose data is used meets a write of the same
+  // memory row in the same cycle, which lets the emitted memories drop the
+  // block RAM's collision bypass (NoCollisionMemories). Runs never overlap
+  // loads, and block 0's read-back comes the cycle after its write.
+  assert(!(io.write.valid && sequencer.io.active), "a box was written while a run read the memories")
+  for (k <- 0 until m)
+    assert(
+      !(loadRead(k) && io.write.valid && io.write.bits.lane === k.U && io.write.bits.row === 0.U),
+      "a block-0 read-back met a write of its row"
+    )
   // While idle every port reads row 0.
   val readRows = VecInit(issue.bits.bRows.map(r => Mux(sequencer.io.active, r, 0.U)))
   buffer.io.readEnable := sequencer.io.active || loadRead.orR

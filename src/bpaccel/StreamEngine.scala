@@ -110,6 +110,10 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       rHasNextBlock := rBlockLeft >= (2 * m).U
     } // past the last block the stream is never compared: hold
   }
+  // readsNeverMeetWrites: the memory is read only while a run is active and
+  // written only while none is, so no read meets a write of its row, which
+  // lets the emitted memory drop the block RAM's collision bypass (NoCollisionMemories).
+  assert(!(io.write.valid && readEvent), "a box was written while the stream read the memory")
   // ---- the memory's read ----
   val read = Wire(Valid(new Entry))
   read.valid    := RegNext(readEvent, false.B)

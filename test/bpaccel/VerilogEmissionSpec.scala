@@ -92,6 +92,25 @@ class VerilogEmissionSpec extends AnyFlatSpec with Matchers {
     }
   }
 
+  for (arch <- Arch.all)
+    it should s"mark every memory array of the ${arch.name} architecture as never read and written at one row at once" in {
+      val (_, dir) = emitted(3, arch)
+      val memories = svFiles(dir).filter(_.startsWith("mem_"))
+      memories should not be empty
+      for (f <- memories)
+        withClue(s"$f: ") {
+          "(?m)^\\s*\\(\\* no_rw_check \\*\\) reg \\[[^\\]]+\\] Memory\\[".r.findAllIn(read(dir, f)).length shouldBe 1
+        }
+    }
+
+  it should "refuse to mark a memory module whose array it does not recognise" in {
+    val (p, dir) = emitted(1)
+    val mem = dir.resolve(s"mem_${p.depth}x${p.keyWidth}.sv")
+    Files.writeString(mem, read(dir, mem.getFileName.toString).replace(s"${NoCollisionMemories.attribute} reg", "reg").replace("Memory[", "Storage["))
+    val e = the[IllegalStateException] thrownBy NoCollisionMemories.rewrite(dir)
+    e.getMessage should include("expected one 'reg [..] Memory[..];', found 0")
+  }
+
   it should "refuse to merge the clocks of a memory whose ports are clocked differently" in {
     val (p, dir) = emitted(1)
     val coords = dir.resolve("CoordBuffer.sv")
