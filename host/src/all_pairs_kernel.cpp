@@ -12,7 +12,8 @@ namespace {
 
 constexpr std::size_t kPad = 8;  // the widest vector, in keys
 // Keys as signed integers (sign bit flipped), so SSE2's signed compare works.
-// Every real key lies strictly between these, so padding never overlaps.
+// Padding overlaps only a box with keys 0 to 2^32-1 on every axis (the
+// KeyBox API lets it through); the loops mask padding lanes off anyway.
 constexpr std::int32_t kNever = std::numeric_limits<std::int32_t>::max();
 constexpr std::int32_t kNeverMax = std::numeric_limits<std::int32_t>::min();
 
@@ -57,6 +58,7 @@ void sse2Pairs(const AllPairsKernel::Scratch& s, std::size_t n, std::vector<Pair
       }
       unsigned bits = ~static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(apart))) & 0xFu;
       if (j0 <= i) bits &= ~0u << (i + 1 - j0);  // only j > i
+      if (n - j0 < 4) bits &= (1u << (n - j0)) - 1;  // only j < n
       emit(static_cast<std::uint32_t>(i), j0, bits, out);
     }
   }
@@ -82,6 +84,7 @@ __attribute__((target("avx2"))) void avx2Pairs(const AllPairsKernel::Scratch& s,
       }
       unsigned bits = ~static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(apart))) & 0xFFu;
       if (j0 <= i) bits &= ~0u << (i + 1 - j0);  // only j > i
+      if (n - j0 < 8) bits &= (1u << (n - j0)) - 1;  // only j < n
       emit(static_cast<std::uint32_t>(i), j0, bits, out);
     }
   }

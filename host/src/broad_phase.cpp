@@ -40,6 +40,7 @@ struct BroadPhase::Worker {
   struct PendingCell {
     std::span<const std::uint32_t> items;  // when referred to
     std::span<const KeyBox> boxes;
+    std::span<const std::uint8_t> below;   // the partition's below() bits, when referred to and it has them
     bool copied = false;
     std::size_t begin = 0, count = 0;      // when copied: where in pendingItems and pendingBoxes
     Cell region{};
@@ -58,19 +59,20 @@ struct BroadPhase::Worker {
   // order when the caller has them (carried tree leaves, grid cells, the whole
   // scene), else empty: they are gathered from `keys`. `lasting`: items and
   // packed stay valid until the batch is flushed, so a batch refers to them.
+  // `below`: the cell's below() bits (with `lasting` only; empty: the region decides).
   void submit(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-              const Cell* region, std::size_t splitAt, int keep, bool lasting);
+              std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep, bool lasting);
   void runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-              const Cell* region, std::size_t splitAt, int keep);
+              std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep);
   void flush();  // hands the pending batch over, if any
   // One hand-over to the backend (`run` fills the record's counters), timed
   // and recorded for the pipeline model, then `decode` of its pairs.
   template <typename Run, typename Decode>
   void handOver(Run&& run, Decode&& decode);
   void keepPairs(std::span<const Pair> pairs, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-                 const Cell* region, std::size_t splitAt, int keep);
+                 std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep);
   void processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-                   const Cell* region, std::size_t capacity, bool lasting);
+                   std::span<const std::uint8_t> below, const Cell* region, std::size_t capacity, bool lasting);
 };
 
 /// The threads of a multi-threaded BroadPhase: an arena of its own, so the
@@ -154,7 +156,7 @@ void BroadPhase::findKeyPairs(std::span<const KeyBox> keys, std::vector<Pair>& o
   if (!cellSize_) {
     identity_.resize(keys.size());
     std::iota(identity_.begin(), identity_.end(), 0u);
-    workers_.front()->processCell(keys, identity_, keys, nullptr, capacity_, true);
+    workers_.front()->processCell(keys, identity_, keys, {}, nullptr, capacity_, true);
     workers_.front()->flush();
     times_.cellsSeconds = seconds(t0, Clock::now());
   } else if (!pool_) {
@@ -167,15 +169,30 @@ void BroadPhase::findKeyPairs(std::span<const KeyBox> keys, std::vector<Pair>& o
 }
 
 // Each cell goes to the backend as soon as the partition has made it (with
-// the tree, the first run is ready long before the tree is finished).
+// the tree, the first run is ready long before the tree is finished). A
+// partition whose cells are all final only at the end (the grid) is built
+// first and its cells then gone through here: no call through the sink and
+// no clock read per cell.
 void BroadPhase::streamCells(std::span<const KeyBox> keys, const KeyBounds* bounds) {
   const auto t0 = Clock::now();
   Worker& w = *workers_.front();
+  if (!partition_->streamsCells()) {
+    partition_->build(keys, *cellSize_, {}, bounds);
+    const auto built = Clock::now();
+    const bool lasting = partition_->cellsOutliveBuild();
+    for (const Cell& cell : partition_->cells())
+      w.processCell(keys, partition_->items(cell), partition_->packed(cell), partition_->below(cell), &cell,
+                    capacity_, lasting);
+    w.flush();  // the last, partly filled batch
+    times_.partitionSeconds = seconds(t0, built);
+    times_.cellsSeconds = seconds(built, Clock::now());
+    return;
+  }
   double inCells = 0;
   partition_->build(keys, *cellSize_, [&](const Cell& leaf, std::span<const std::uint32_t> items,
                                           std::span<const KeyBox> packed) {
     const auto c0 = Clock::now();
-    w.processCell(keys, items, packed, &leaf, capacity_, partition_->cellsOutliveBuild());
+    w.processCell(keys, items, packed, {}, &leaf, capacity_, partition_->cellsOutliveBuild());
     inCells += seconds(c0, Clock::now());
   }, bounds);
   const auto f0 = Clock::now();
@@ -205,7 +222,7 @@ void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys, const KeyBou
       tasks.run([this, keys, leaf, &copy] {
         // Inside this arena, thread indices are 0 .. threads-1: one worker each.
         Worker& w = *workers_.at(static_cast<std::size_t>(tbb::this_task_arena::current_thread_index()));
-        w.processCell(keys, copy.items, copy.packed, &leaf, capacity_, false);
+        w.processCell(keys, copy.items, copy.packed, {}, &leaf, capacity_, false);
       });
     }, bounds);
     built = Clock::now();
@@ -233,8 +250,10 @@ void BroadPhase::startCells(Clock::time_point frameStart) {
 
 void BroadPhase::finishCells(std::vector<Pair>& out) {
   runs_.clear();
+  // One worker hands its pairs over without a copy (and takes the caller's empty buffer for the next frame).
+  if (workers_.size() == 1) out.swap(workers_.front()->out);
   for (auto& w : workers_) {
-    out.insert(out.end(), w->out.begin(), w->out.end());
+    if (workers_.size() > 1) out.insert(out.end(), w->out.begin(), w->out.end());
     stats_ += w->stats;
     times_.backendSeconds += w->backendSeconds;
     runs_.insert(runs_.end(), w->runs.begin(), w->runs.end());
@@ -246,11 +265,11 @@ void BroadPhase::finishCells(std::vector<Pair>& out) {
 // pairs, and each chunk's inside pairs are kept from exactly one run: chunk
 // p from run (p, p+1), the last chunk from run (k-2, k-1).
 void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
-                                     std::span<const KeyBox> packed, const Cell* region,
-                                     std::size_t capacity, bool lasting) {
+                                     std::span<const KeyBox> packed, std::span<const std::uint8_t> below,
+                                     const Cell* region, std::size_t capacity, bool lasting) {
   if (items.size() < 2) return;
   if (items.size() <= capacity) {
-    submit(keys, items, packed, region, items.size(), kFirstInside, lasting);
+    submit(keys, items, packed, below, region, items.size(), kFirstInside, lasting);
     return;
   }
   const std::size_t chunk = capacity / 2;
@@ -265,16 +284,17 @@ void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<con
       int keep = kCross;
       if (q == p + 1) keep |= kFirstInside;
       if (p == k - 2 && q == k - 1) keep |= kSecondInside;
-      submit(keys, pairItems, {}, region, first.size(), keep, false);
+      submit(keys, pairItems, {}, {}, region, first.size(), keep, false);
     }
   }
 }
 
 void BroadPhase::Worker::submit(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
-                                std::span<const KeyBox> packed, const Cell* region, std::size_t splitAt,
-                                int keep, bool lasting) {
+                                std::span<const KeyBox> packed, std::span<const std::uint8_t> below,
+                                const Cell* region, std::size_t splitAt, int keep, bool lasting) {
+  if (!lasting) below = {};  // valid during the call only: the region decides
   if (cellsPerBatch <= 1) {
-    runNow(keys, items, packed, region, splitAt, keep);
+    runNow(keys, items, packed, below, region, splitAt, keep);
     return;
   }
   PendingCell cell;
@@ -285,6 +305,7 @@ void BroadPhase::Worker::submit(std::span<const KeyBox> keys, std::span<const st
   if (lasting && !packed.empty()) {
     cell.items = items;
     cell.boxes = packed;
+    cell.below = below;
   } else {
     cell.copied = true;
     cell.begin = pendingItems.size();
@@ -321,7 +342,7 @@ void BroadPhase::Worker::flush() {
         for (std::size_t c = 0; c < pending.size(); ++c) {
           const PendingCell& cell = pending[c];
           keepPairs(std::span<const Pair>(local).subspan(from, cellEnds[c] - from), cellItems[c], cellSpans[c],
-                    cell.hasRegion ? &cell.region : nullptr, cell.splitAt, cell.keep);
+                    cell.below, cell.hasRegion ? &cell.region : nullptr, cell.splitAt, cell.keep);
           from = cellEnds[c];
         }
       });
@@ -331,8 +352,8 @@ void BroadPhase::Worker::flush() {
 }
 
 void BroadPhase::Worker::runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
-                                std::span<const KeyBox> packed, const Cell* region, std::size_t splitAt,
-                                int keep) {
+                                std::span<const KeyBox> packed, std::span<const std::uint8_t> below,
+                                const Cell* region, std::size_t splitAt, int keep) {
   if (packed.empty()) {
     gathered.resize(items.size());
     for (std::size_t t = 0; t < items.size(); ++t) gathered[t] = keys[items[t]];
@@ -340,7 +361,7 @@ void BroadPhase::Worker::runNow(std::span<const KeyBox> keys, std::span<const st
   }
   local.clear();
   handOver([&](RunStats& runStats) { backend->run(packed, local, runStats); },
-           [&] { keepPairs(local, items, packed, region, splitAt, keep); });
+           [&] { keepPairs(local, items, packed, below, region, splitAt, keep); });
 }
 
 template <typename Run, typename Decode>
@@ -359,10 +380,21 @@ void BroadPhase::Worker::handOver(Run&& run, Decode&& decode) {
 
 // Keeps the pairs of one device cell that this cell owns: the kinds `keep`
 // asks for (a chunk pair's cross pairs, or the inside pairs of one chunk),
-// and only those whose reference point lies in the cell's region.
+// and only those whose reference point lies in the cell's region: for a
+// whole cell with the partition's below() bits, decided from two bytes
+// instead of two boxes; else from the boxes (chunks pass no bits).
 void BroadPhase::Worker::keepPairs(std::span<const Pair> pairs, std::span<const std::uint32_t> items,
-                                   std::span<const KeyBox> packed, const Cell* region, std::size_t splitAt,
-                                   int keep) {
+                                   std::span<const KeyBox> packed, std::span<const std::uint8_t> below,
+                                   const Cell* region, std::size_t splitAt, int keep) {
+  if (!below.empty() && keep == kFirstInside && splitAt == items.size()) {
+    // One run of the whole cell: every pair is an inside pair of the first chunk.
+    for (const auto& [a, b] : pairs) {
+      if (!ownsPair(below[a], below[b])) continue;
+      const std::uint32_t i = items[a], j = items[b];
+      out.emplace_back(std::min(i, j), std::max(i, j));
+    }
+    return;
+  }
   for (const auto& [a, b] : pairs) {
     const bool firstA = a < splitAt, firstB = b < splitAt;
     const int kind = firstA != firstB ? kCross : (firstA ? kFirstInside : kSecondInside);

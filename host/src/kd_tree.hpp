@@ -49,6 +49,7 @@ class KdTree final : public Partition {
     build(boxes, cellSize, onCell, Layout::Auto);
   }
   std::string_view name() const override { return "k-d"; }
+  bool streamsCells() const override { return true; }
 
   const std::vector<Leaf>& cells() const override { return leaves_; }
   /// Item entries the tree's buffers hold (their capacity): what its memory

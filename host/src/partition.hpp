@@ -61,7 +61,26 @@ class Partition {
   /// stay valid until the next build (a batch may then refer to them instead
   /// of copying); otherwise they are valid during the call only.
   virtual bool cellsOutliveBuild() const { return false; }
+  /// Whether build hands each cell to its sink while it goes on (the tree:
+  /// the first cell is ready long before the last). Otherwise every cell is
+  /// final only at the end, and a caller may build without a sink and go
+  /// through cells() itself (no call through the sink per cell).
+  virtual bool streamsCells() const { return false; }
+  /// A cell of the last build, its boxes packed in item order, when the
+  /// partition keeps them until the next build; else empty.
+  virtual std::span<const KeyBox> packed(const Cell&) const { return {}; }
+  /// Per item of a cell of the last build, when the partition keeps them
+  /// until the next build (else empty): bit a set when the box's min lies
+  /// below the cell's region on axis a (belowBits). They decide a pair's
+  /// reference point without its boxes (ownsPair).
+  virtual std::span<const std::uint8_t> below(const Cell&) const { return {}; }
 };
+
+/// The bits of below(): axis a's bit set when `min[a] < lo[a]`.
+inline std::uint8_t belowBits(const std::array<std::uint32_t, 3>& min, const std::array<std::uint64_t, 3>& lo) {
+  return static_cast<std::uint8_t>(static_cast<unsigned>(min[0] < lo[0]) | static_cast<unsigned>(min[1] < lo[1]) << 1 |
+                                   static_cast<unsigned>(min[2] < lo[2]) << 2);
+}
 
 enum class PartitionKind { KdTree, UniformGrid };
 
@@ -77,5 +96,11 @@ PartitionKind parsePartitionKind(const std::string& text);
 inline std::array<std::uint32_t, 3> referencePoint(const KeyBox& a, const KeyBox& b) {
   return {std::max(a.min[0], b.min[0]), std::max(a.min[1], b.min[1]), std::max(a.min[2], b.min[2])};
 }
+
+/// The same rule from two boxes' below() bits in a cell that holds both: the
+/// reference point's coordinate on an axis is the larger min, below the
+/// region's hi since both boxes touch the region; it lies below the region's
+/// lo exactly when both mins do.
+inline bool ownsPair(std::uint8_t belowA, std::uint8_t belowB) { return (belowA & belowB) == 0; }
 
 }  // namespace bpaccel

@@ -241,8 +241,8 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
     if (extras_.size() < extra + std::max<std::uint64_t>(others, 7)) extras_.resize(2 * (extra + others) + 8);
     Extra* const slots = extras_.data();
     const std::uint32_t id = straddlers[k];
-    forEachOtherCell(r, [&](std::uint64_t cell, unsigned inside) {
-      slots[extra] = {cell, id};
+    forEachOtherCell(r, [&](std::uint64_t cell, unsigned inside, unsigned below) {
+      slots[extra] = {cell, id, static_cast<std::uint8_t>(below)};
       extra += inside;
     });
   }
@@ -261,14 +261,17 @@ void UniformGrid::forEachOtherCell(const Range& r, F&& f) const {
       const unsigned ox = o & 1, oy = (o >> 1) & 1, oz = o >> 2;
       const unsigned inside = static_cast<unsigned>(ox <= dx) & static_cast<unsigned>(oy <= dy) &
                               static_cast<unsigned>(oz <= dz);
-      f(base + ox + oy * nx + oz * nx * ny, inside);
+      f(base + ox + oy * nx + oz * nx * ny, inside, o);
     }
     return;
   }
   for (std::uint32_t z = r.first[2]; z <= r.last[2]; ++z)
     for (std::uint32_t y = r.first[1]; y <= r.last[1]; ++y)
-      for (std::uint32_t x = r.first[0]; x <= r.last[0]; ++x)
-        if (x != r.first[0] || y != r.first[1] || z != r.first[2]) f((z * ny + y) * nx + x, 1u);
+      for (std::uint32_t x = r.first[0]; x <= r.last[0]; ++x) {
+        const unsigned below = static_cast<unsigned>(x != r.first[0]) | static_cast<unsigned>(y != r.first[1]) << 1 |
+                               static_cast<unsigned>(z != r.first[2]) << 2;
+        if (below) f((z * ny + y) * nx + x, 1u, below);
+      }
 }
 
 void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell,
@@ -301,15 +304,25 @@ void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, con
         total += count;
       }
   items_.resize(total);
+  itemBelow_.resize(total);
   packed_.resize(total);
-  // Scatter (offsets_ becomes the cursor): every box into its first cell,
-  // then the straddlers into their others.
+  // Scatter (offsets_ becomes the cursor): every box into its first cell
+  // (below no axis there), then the straddlers into their others.
   std::uint64_t* const cursor = offsets_.data();
   std::uint32_t* const items = items_.data();
+  std::uint8_t* const below = itemBelow_.data();
   KeyBox* const packed = packed_.data();
   const std::uint32_t* const firsts = firstCell_.data();
-  for (std::size_t i = 0; i < boxes.size(); ++i) items[cursor[firsts[i]]++] = static_cast<std::uint32_t>(i);
-  for (const Extra& e : std::span<const Extra>(extras_).first(extraCount_)) items[cursor[e.cell]++] = e.id;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const std::uint64_t at = cursor[firsts[i]]++;
+    items[at] = static_cast<std::uint32_t>(i);
+    below[at] = 0;
+  }
+  for (const Extra& e : std::span<const Extra>(extras_).first(extraCount_)) {
+    const std::uint64_t at = cursor[e.cell]++;
+    items[at] = e.id;
+    below[at] = e.below;
+  }
   // The boxes gathered in cell order: writing them in order is cheaper than
   // scattering them with their indices (one cache line filled at a time).
   for (std::uint64_t t = 0; t < total; ++t) packed[t] = boxes[items[t]];

@@ -68,8 +68,19 @@ class UniformGrid final : public Partition {
     if (fellBack_) return fallback_.items(cell);
     return {items_.data() + cell.begin, cell.count};
   }
-  /// The cells' boxes in the device's layout, like items(cell) (without a fallback).
-  std::span<const KeyBox> packed(const Cell& cell) const { return {packed_.data() + cell.begin, cell.count}; }
+  /// The cells' boxes in the device's layout, like items(cell) (empty after a fallback).
+  std::span<const KeyBox> packed(const Cell& cell) const override {
+    if (fellBack_) return {};
+    return {packed_.data() + cell.begin, cell.count};
+  }
+  /// Known without comparing keys: a box's first cell (its min's) lies at or
+  /// above the cell on every axis; a straddler's other cells are the offsets
+  /// from its first, and an offset on an axis is that axis's bit (see
+  /// forEachOtherCell). Empty after a fallback.
+  std::span<const std::uint8_t> below(const Cell& cell) const override {
+    if (fellBack_) return {};
+    return {itemBelow_.data() + cell.begin, cell.count};
+  }
   bool cellsOutliveBuild() const override { return !fellBack_; }
 
   /// Whether the last build gave the scene to the k-d tree (see above).
@@ -78,7 +89,7 @@ class UniformGrid final : public Partition {
   std::array<std::uint32_t, 3> resolution() const;
   /// Item entries the grid's buffers hold (their capacity).
   std::size_t storedItems() const {
-    return items_.capacity() + offsets_.capacity() + firstCell_.capacity() +
+    return items_.capacity() + itemBelow_.capacity() + offsets_.capacity() + firstCell_.capacity() +
            straddlers_.capacity() + straddlerRanges_.capacity() + extras_.capacity();
   }
   /// Boxes the grid's packed copy holds (its capacity).
@@ -101,16 +112,18 @@ class UniformGrid final : public Partition {
   // Counts each cell's boxes into offsets_; false when the boxes would join too many cells.
   bool countBoxes(std::span<const KeyBox> boxes);
   void chooseResolution(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds& bounds);
-  // Calls f(cell, 1) for each cell of r but its first: branch-free when r
-  // spans at most two cells an axis (boxes smaller than cells, nearly every
-  // straddler), with f(any number, 0) for each of the seven neighbours the
-  // box misses; else by loops.
+  // Calls f(cell, 1, below) for each cell of r but its first, `below` the
+  // axes on which that cell lies above r's first (the box's min below it):
+  // branch-free when r spans at most two cells an axis (boxes smaller than
+  // cells, nearly every straddler), with f(any number, 0, any) for each of
+  // the seven neighbours the box misses; else by loops.
   template <typename F>
   void forEachOtherCell(const Range& r, F&& f) const;
   // A straddler's entry in one of its other cells.
   struct Extra {
     std::uint64_t cell;
     std::uint32_t id;
+    std::uint8_t below;  // the box's below() bits in that cell
   };
 
   std::array<Axis, 3> axes_;
@@ -122,6 +135,7 @@ class UniformGrid final : public Partition {
   std::size_t extraCount_ = 0;            // how many of those this frame holds
   std::vector<std::uint64_t> offsets_;   // per cell: its count, then its first item, then the scatter cursor
   std::vector<std::uint32_t> items_;     // the cells' item lists, in cell order
+  std::vector<std::uint8_t> itemBelow_;  // each item's below() bits, in the same order
   std::vector<KeyBox> packed_;           // their boxes, in the same order
   std::vector<Cell> cells_;
   KdTree fallback_;

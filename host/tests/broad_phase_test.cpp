@@ -188,6 +188,22 @@ TEST(AllPairsKernel, SimdGivesTheScalarPairsInTheSameOrderForEverySize) {
     }
 }
 
+TEST(AllPairsKernel, BoxesOverEveryKeyPairOnlyWithBoxesNotWithThePadding) {
+  // Keys 0 and 2^32-1 are the padding's own values: a box over all of key
+  // space overlaps the padding lanes, which must never become pairs.
+  const std::uint32_t top = ~0u;
+  const AllPairsKernel simd;
+  AllPairsKernel::Scratch scratch;
+  for (std::size_t n = 1; n <= 19; ++n) {
+    std::vector<KeyBox> keys(n, KeyBox{{0, 0, 0}, {top, top, top}});
+    std::vector<Pair> pairs, all;
+    simd.run(keys, pairs, scratch);
+    for (std::uint32_t i = 0; i < n; ++i)
+      for (std::uint32_t j = i + 1; j < n; ++j) all.emplace_back(i, j);
+    EXPECT_EQ(pairs, all) << "n=" << n << " isa " << simd.isa();
+  }
+}
+
 TEST(BroadPhase, SeveralThreadsGiveExactlyTheSinglePairs) {
   for (std::size_t threads : {2u, 3u}) {
     BroadPhase cpu([] { return std::make_unique<CpuBackend>(); }, 8, threads);

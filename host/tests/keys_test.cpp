@@ -78,7 +78,9 @@ TEST(CheckObjectCount, RejectsMoreObjectsThanIndicesCanAddress) {
 // The conversion works on several boxes at once: a bad field is found at
 // every position within a group and on every axis, and named.
 TEST(ToKeys, RejectsEveryBadFieldAtEveryPositionOfAGroupOfBoxes) {
-  for (std::size_t n : {1u, 2u, 3u, 4u, 5u}) {
+  // Up to 11: every position of the AVX2 loop's groups of four, the SSE2
+  // loop's pair after them and the scalar tail.
+  for (std::size_t n = 1; n <= 11; ++n) {
     for (std::size_t at = 0; at < n; ++at) {
       for (int a = 0; a < 3; ++a) {
         for (int kind = 0; kind < 3; ++kind) {  // NaN min, NaN max, min above max
@@ -108,14 +110,45 @@ TEST(ToKeys, RejectsEveryBadFieldAtEveryPositionOfAGroupOfBoxes) {
   EXPECT_EQ(keys[3].min[0], keys[3].max[0]);
 }
 
+TEST(ToKeys, GivesEveryBoxTheKeysOfItsFloatsForEveryCount) {
+  // Counts up to 13 cover every way the vector loops (four boxes, then two)
+  // and the scalar tail share the boxes; the values include both zeros,
+  // infinities and subnormals.
+  std::mt19937 rng(11);
+  const std::vector<float> special = {0.0f, -0.0f, std::numeric_limits<float>::infinity(),
+                                      -std::numeric_limits<float>::infinity(), 1e-40f, -1e-40f,
+                                      std::numeric_limits<float>::max(), -std::numeric_limits<float>::max()};
+  std::uniform_real_distribution<float> coordinate(-1e4f, 1e4f);
+  for (int trial = 0; trial < 40; ++trial)
+    for (std::size_t n = 0; n <= 13; ++n) {
+      std::vector<Aabb> boxes(n);
+      for (Aabb& b : boxes)
+        for (int a = 0; a < 3; ++a) {
+          float x = rng() % 4 == 0 ? special[rng() % special.size()] : coordinate(rng);
+          float y = rng() % 4 == 0 ? special[rng() % special.size()] : coordinate(rng);
+          if (floatToKey(y) < floatToKey(x)) std::swap(x, y);
+          b.min[a] = x;
+          b.max[a] = y;
+        }
+      std::vector<KeyBox> keys;
+      toKeys(boxes, keys);
+      ASSERT_EQ(keys.size(), n);
+      for (std::size_t i = 0; i < n; ++i)
+        for (int a = 0; a < 3; ++a) {
+          EXPECT_EQ(keys[i].min[a], floatToKey(boxes[i].min[a])) << n << " boxes, box " << i << " axis " << a;
+          EXPECT_EQ(keys[i].max[a], floatToKey(boxes[i].max[a])) << n << " boxes, box " << i << " axis " << a;
+        }
+    }
+}
+
 // The bounds found while converting are each axis's lowest min and highest
-// max, computed here one box at a time, for every count up to nine (the
-// vector loop's pairs and the scalar tail) and for random signs and sizes.
+// max, computed here one box at a time, for every count up to 13 (the
+// vector loops' groups and the scalar tail) and for random signs and sizes.
 TEST(ToKeys, FindsTheLowestMinAndHighestMaxOfEveryAxisWhileConverting) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> coordinate(-1e6f, 1e6f), size(0.0f, 1e3f);
   for (int trial = 0; trial < 50; ++trial) {
-    for (std::size_t n = 0; n <= 9; ++n) {
+    for (std::size_t n = 0; n <= 13; ++n) {
       std::vector<Aabb> boxes(n);
       for (Aabb& b : boxes)
         for (int a = 0; a < 3; ++a) {

@@ -123,6 +123,61 @@ TEST(UniformGrid, CellsPartitionKeySpaceAndHoldEveryBoxTheyTouch) {
   EXPECT_GE(gridded, 15u) << "most adversarial scenes should be gridded, not handed to the tree";
 }
 
+TEST(UniformGrid, BelowBitsSayOnWhichAxesEachItemsBoxStartsBelowItsCell) {
+  std::size_t gridded = 0, withBits = 0;
+  for (const auto& [name, boxes] : adversarialScenes(300, 6)) {
+    std::vector<KeyBox> keys;
+    toKeys(boxes, keys);
+    for (std::size_t cell : {2u, 16u, 64u}) {
+      UniformGrid grid;
+      grid.build(keys, cell, {});
+      const std::string label = name + " cell " + std::to_string(cell);
+      if (grid.fellBack()) {
+        for (const Cell& c : grid.cells()) EXPECT_TRUE(grid.below(c).empty()) << label << ": the tree has no bits";
+        continue;
+      }
+      ++gridded;
+      for (const Cell& c : grid.cells()) {
+        const auto items = grid.items(c);
+        const auto below = grid.below(c);
+        ASSERT_EQ(below.size(), items.size()) << label;
+        for (std::size_t t = 0; t < items.size(); ++t) {
+          EXPECT_EQ(below[t], belowBits(keys[items[t]].min, c.lo)) << label << " box " << items[t];
+          withBits += below[t] != 0;
+        }
+      }
+    }
+  }
+  EXPECT_GE(gridded, 15u);
+  EXPECT_GT(withBits, 0u) << "some straddlers lie in cells above their first";
+}
+
+TEST(UniformGrid, OwnsPairFromBelowBitsAgreesWithTheReferencePointInTheRegion) {
+  // Any two boxes that touch a region: the bits decide as the point does.
+  std::mt19937 rng(5);
+  const Cell region{0, 0, {100, 100, 100}, {200, 200, 200}};
+  const auto coordinate = [&] { return static_cast<std::uint32_t>(50 + rng() % 200); };
+  for (int t = 0; t < 20000; ++t) {
+    KeyBox b[2];
+    for (KeyBox& k : b)
+      for (int a = 0; a < 3; ++a) {
+        do {
+          k.min[a] = coordinate();
+          k.max[a] = k.min[a] + rng() % 120;
+        } while (!(k.min[a] < region.hi[a] && k.max[a] >= region.lo[a]));  // touches the region on axis a
+      }
+    EXPECT_EQ(ownsPair(belowBits(b[0].min, region.lo), belowBits(b[1].min, region.lo)),
+              region.contains(referencePoint(b[0], b[1])));
+  }
+}
+
+TEST(UniformGrid, HandsItsCellsOverAtTheEndWhileTheTreeStreamsThem) {
+  EXPECT_FALSE(UniformGrid().streamsCells()) << "BroadPhase goes through the grid's cells after the build";
+  EXPECT_TRUE(KdTree().streamsCells()) << "the tree's first leaf goes to the device before the tree is done";
+  EXPECT_TRUE(KdTree().below(Cell{}).empty());
+  EXPECT_TRUE(KdTree().packed(Cell{}).empty());
+}
+
 TEST(UniformGrid, AimsAtTwoNOverCellSizeCellsOnAUniformScene) {
   const std::vector<Aabb> boxes = scatteredBoxes(8000, 3, 0, 54, 0.5f, 2.5f);
   std::vector<KeyBox> keys;
