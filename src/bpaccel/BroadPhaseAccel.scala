@@ -100,7 +100,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   control.io.engine := engine.io.activity
 
   val beat = engine.io.out
-  queue.io.enq.valid := beat.valid && beat.bits.mask.orR
+  queue.io.enq.valid := beat.valid && engine.io.outHit
   queue.io.enq.bits.iBase := beat.bits.iBase
   queue.io.enq.bits.jBase := beat.bits.jBase
   queue.io.enq.bits.mask  := beat.bits.mask

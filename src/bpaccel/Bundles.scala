@@ -100,6 +100,7 @@ class EngineIO(p: AccelParams) extends Bundle {
   val room     = Input(Bool())                        // the result queue has room for one more issue next cycle
   val activity = Output(new EngineActivity(p))
   val out      = Valid(new ScheduleBeat(p))           // one per issued cycle, mask = hits
+  val outHit   = Output(Bool())                       // out.bits.mask =/= 0, from a register of its own
   val probe    = if (p.debugPort) Some(Output(new DebugProbe(p))) else None
 }
 
@@ -112,6 +113,13 @@ abstract class Engine(val p: AccelParams) extends Module {
     */
   protected val advance = RegNext(io.room, false.B)
 
+  /** The AND stage's registers: each lane's hit, and whether any lane hit.
+    * The OR of the lanes is taken before the register, so that no OR tree
+    * sits between the last stage and the result queue's write (stream
+    * m = 32's critical path, 106.5 MHz: the hit mask's OR into the queue).
+    */
+  protected def hitRegisters(hits: UInt): (UInt, Bool) = (RegNext(hits), RegNext(hits.orR))
+
   /** Drives the result and the debug probe from the pipeline's last stage. */
   protected def emit(
     valid: Bool,
@@ -120,12 +128,15 @@ abstract class Engine(val p: AccelParams) extends Module {
     laneMask: UInt,
     probeI: Vec[UInt],
     probeJ: Vec[UInt],
-    hitMask: UInt
+    hitMask: UInt,
+    anyHit: Bool
   ): Unit = {
     io.out.valid      := valid
     io.out.bits.iBase := iBase
     io.out.bits.jBase := jBase
     io.out.bits.mask  := hitMask
+    io.outHit         := anyHit
+    assert(!valid || anyHit === hitMask.orR, "the any-hit register does not match the hit mask")
     io.probe.foreach { d =>
       d.cycleValid := valid
       for (k <- 0 until p.m) {

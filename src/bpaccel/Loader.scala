@@ -12,6 +12,8 @@ class LoadWrite(p: AccelParams) extends Bundle {
   val lane  = UInt(p.laneWidth.W)
   val row   = UInt(p.rowWidth.W)
   val box   = new Aabb(p.keyWidth)
+  /** One-hot: bit k set when this is object k < m, one of block 0's A objects. */
+  val firstBlockLane = UInt(p.m.W)
 }
 
 /** Numbers the boxes of a run in load order and refuses (with `overflow`)
@@ -30,13 +32,20 @@ class Loader(p: AccelParams) extends Module {
   val lane     = RegInit(0.U(p.laneWidth.W))
   val row      = RegInit(0.U(p.rowWidth.W))
   val overflow = RegInit(false.B)
-  val full     = loaded === p.capacity.U
+  // Registers, not compares of `loaded` and `row`/`lane`: a write's valid and
+  // block 0's lane reach the engine's per-lane registers through no compare
+  // (seed m = 8's critical path ran from `loaded` through both to `loadRead`).
+  val full           = RegInit(false.B) // loaded == capacity
+  val firstBlockLane = RegInit(1.U(m.W)) // one-hot lane while row 0, then 0
+  assert(full === (loaded === p.capacity.U), "the loader's full flag does not match its count")
+  assert(firstBlockLane === Mux(row === 0.U, UIntToOH(lane, m), 0.U), "the loader's block-0 lane does not match its row and lane")
 
   io.write.valid      := io.load.valid && !full
   io.write.bits.index := loaded
   io.write.bits.lane  := lane
   io.write.bits.row   := row
   io.write.bits.box   := io.load.bits
+  io.write.bits.firstBlockLane := firstBlockLane
   io.loaded           := loaded
   io.overflow         := overflow
 
@@ -44,7 +53,9 @@ class Loader(p: AccelParams) extends Module {
     when(full) {
       overflow := true.B
     }.otherwise {
-      loaded := loaded + 1.U
+      loaded         := loaded + 1.U
+      full           := loaded === (p.capacity - 1).U
+      firstBlockLane := (firstBlockLane << 1)(m - 1, 0)
       if (m == 1) row := row + 1.U
       else {
         val lastLane = lane === (m - 1).U
@@ -58,5 +69,7 @@ class Loader(p: AccelParams) extends Module {
     lane     := 0.U
     row      := 0.U
     overflow := false.B
+    full     := false.B
+    firstBlockLane := 1.U
   }
 }

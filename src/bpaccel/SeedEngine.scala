@@ -46,10 +46,7 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   val issue = sequencer.io.issue
 
   // Read back block 0's A objects the cycle after they are written.
-  val loadRead = RegNext(
-    VecInit(Seq.tabulate(m)(k => io.write.valid && io.write.bits.row === 0.U && io.write.bits.lane === k.U)).asUInt,
-    0.U(m.W)
-  )
+  val loadRead = RegNext(Mux(io.write.valid, io.write.bits.firstBlockLane, 0.U), 0.U(m.W))
   // readsNeverMeetWrites: no read whose data is used meets a write of the same
   // memory row in the same cycle, which lets the emitted memories drop the
   // block RAM's collision bypass (NoCollisionMemories). Runs never overlap
@@ -57,7 +54,7 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   assert(!(io.write.valid && sequencer.io.active), "a box was written while a run read the memories")
   for (k <- 0 until m)
     assert(
-      !(loadRead(k) && io.write.valid && io.write.bits.lane === k.U && io.write.bits.row === 0.U),
+      !(loadRead(k) && io.write.valid && io.write.bits.firstBlockLane(k)),
       "a block-0 read-back met a write of its row"
     )
   // While idle every port reads row 0.
@@ -126,7 +123,7 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   // Comparators and AND gates, registered.
   compare.io.a := aBlock
   compare.io.b := rotatedB
-  val hitMask   = RegNext(compare.io.hits & atRotated.bits.laneMask)
+  val (hitMask, anyHit) = hitRegisters(compare.io.hits & atRotated.bits.laneMask)
   val atCompare = Pipe(atRotated)
   val probeI    = RegNext(aBlockTag)
 
@@ -139,5 +136,5 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   io.activity.inFlight := PopCount(stages.map(_.valid))
   io.activity.retired  := stages.last.valid
 
-  emit(atCompare.valid, atCompare.bits.iBase, atCompare.bits.jBase, atCompare.bits.laneMask, probeI, atCompare.bits.probeJ, hitMask)
+  emit(atCompare.valid, atCompare.bits.iBase, atCompare.bits.jBase, atCompare.bits.laneMask, probeI, atCompare.bits.probeJ, hitMask, anyHit)
 }

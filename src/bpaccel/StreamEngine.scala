@@ -217,10 +217,10 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // The last box of a run may shift in at the launch, so its capture may come
   // after the startup copied aNext into a: harmless, as object n-1 is never
   // an A object that is compared (no object follows it).
-  // Decoded into one register per lane before the cycle it is used: the
-  // compare of the loaded index with k sat in front of lane k's 192 enables
-  // (stream m = 64's critical path, 82.1 MHz).
-  val loadedTop = VecInit(Seq.tabulate(m)(k => RegNext(loadShift && loadedBox.bits.index === k.U, false.B)))
+  // One register per lane, from the loader's one-hot lane: the compare of
+  // the loaded index with k sat in front of lane k's 192 enables (stream
+  // m = 64's critical path, 82.1 MHz).
+  val loadedTop = VecInit(Seq.tabulate(m)(k => RegNext(loadShift && loadedBox.bits.firstBlockLane(k), false.B)))
   // Later blocks: cycle k of a block finds object base+m+k in the top lane.
   val capture = Reg(UInt(m.W)) // one-hot: lane of aNext to fill at this issue
   for (k <- 0 until m) {
@@ -361,7 +361,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     )).asUInt
   }))
   val atCompare = Pipe(issue, meta)
-  val hitMask   = RegNext(VecInit(compared.map(_.andR)).asUInt & atCompare.bits.laneMask)
+  val (hitMask, anyHit) = hitRegisters(VecInit(compared.map(_.andR)).asUInt & atCompare.bits.laneMask)
   val atAnd     = Pipe(atCompare)
   require(p.pipelineLatency == 2)
 
@@ -386,5 +386,5 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   val outValid =
     if (p.has(Fault.RepeatLastBeat)) atAnd.valid || (RegNext(atAnd.valid, false.B) && !atAnd.valid) else atAnd.valid
-  emit(outValid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, atAnd.bits.probeI, atAnd.bits.probeJ, hitMask)
+  emit(outValid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, atAnd.bits.probeI, atAnd.bits.probeJ, hitMask, anyHit)
 }
