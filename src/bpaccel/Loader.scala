@@ -38,7 +38,9 @@ class Loader(p: AccelParams) extends Module {
   val full           = RegInit(false.B) // loaded == capacity
   val firstBlockLane = RegInit(1.U(m.W)) // one-hot lane while row 0, then 0
   assert(full === (loaded === p.capacity.U), "the loader's full flag does not match its count")
-  assert(firstBlockLane === Mux(row === 0.U, UIntToOH(lane, m), 0.U), "the loader's block-0 lane does not match its row and lane")
+  private val firstBlockLaneOfCount =
+    if (m == 1) (loaded === 0.U).asUInt else Mux(loaded < m.U, UIntToOH(loaded.pad(log2Ceil(m))(log2Ceil(m) - 1, 0), m), 0.U)
+  assert(firstBlockLane === firstBlockLaneOfCount, "the loader's block-0 lane does not match its count")
 
   io.write.valid      := io.load.valid && !full
   io.write.bits.index := loaded
