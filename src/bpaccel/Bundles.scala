@@ -100,7 +100,7 @@ class EngineIO(p: AccelParams) extends Bundle {
   val room     = Input(Bool())                        // the result queue has room for one more issue next cycle
   val activity = Output(new EngineActivity(p))
   val out      = Valid(new ScheduleBeat(p))           // one per issued cycle, mask = hits
-  val outHit   = Output(Bool())                       // out.bits.mask =/= 0, from a register of its own
+  val outHit   = Output(Bool())                       // out.bits.mask =/= 0 (the stream registers it beside the mask)
   val probe    = if (p.debugPort) Some(Output(new DebugProbe(p))) else None
 }
 
@@ -117,6 +117,7 @@ abstract class Engine(val p: AccelParams) extends Module {
     * The OR of the lanes is taken before the register, so that no OR tree
     * sits between the last stage and the result queue's write (stream
     * m = 32's critical path, 106.5 MHz: the hit mask's OR into the queue).
+    * Only for an engine whose compares are registered before the AND.
     */
   protected def hitRegisters(hits: UInt): (UInt, Bool) = (RegNext(hits), RegNext(hits.orR))
 
