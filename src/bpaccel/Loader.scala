@@ -38,8 +38,7 @@ class Loader(p: AccelParams) extends Module {
   val full           = RegInit(false.B) // loaded == capacity
   val firstBlockLane = RegInit(1.U(m.W)) // one-hot lane while row 0, then 0
   assert(full === (loaded === p.capacity.U), "the loader's full flag does not match its count")
-  private val firstBlockLaneOfCount =
-    if (m == 1) (loaded === 0.U).asUInt else Mux(loaded < m.U, UIntToOH(loaded.pad(log2Ceil(m))(log2Ceil(m) - 1, 0), m), 0.U)
+  private val firstBlockLaneOfCount = VecInit(Seq.tabulate(m)(k => loaded === k.U)).asUInt
   assert(firstBlockLane === firstBlockLaneOfCount, "the loader's block-0 lane does not match its count")
 
   io.write.valid      := io.load.valid && !full
