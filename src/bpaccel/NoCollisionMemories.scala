@@ -2,7 +2,6 @@ package bpaccel
 
 import java.nio.file.{Files, Path}
 
-import scala.jdk.CollectionConverters._
 import scala.util.matching.Regex
 
 /** Tells synthesis that no memory is read and written at the same row in the
@@ -29,10 +28,9 @@ object NoCollisionMemories {
 
   /** Marks the array of every memory module `mem_*.sv` that `dir/filelist.f` lists; returns their files. */
   def rewrite(dir: Path): Seq[String] = {
-    val memories = Files.readAllLines(dir.resolve("filelist.f")).asScala.map(_.trim)
-      .filter(f => f.startsWith("mem_") && f.endsWith(".sv")).toSeq
-    for (file <- memories) {
-      val path = dir.resolve(file)
+    val memories = SingleClockMemories.memoryFiles(dir)
+    for (path <- memories) {
+      val file = path.getFileName.toString
       val text = Files.readString(path)
       val declarations = ArrayDeclaration.findAllMatchIn(text).length
       if (declarations != 1)
@@ -40,6 +38,6 @@ object NoCollisionMemories {
       if (!text.contains(attribute))
         Files.writeString(path, ArrayDeclaration.replaceAllIn(text, m => Regex.quoteReplacement(s"${m.group(1)}$attribute ${m.group(2)}")))
     }
-    memories
+    memories.map(_.getFileName.toString)
   }
 }

@@ -30,9 +30,8 @@ object SingleClockMemories {
     * the other files it lists (only those: firtool leaves older files of the folder alone).
     */
   def rewrite(dir: Path): Seq[String] = {
-    val svFiles = Files.readAllLines(dir.resolve("filelist.f")).asScala.map(_.trim).filter(_.endsWith(".sv"))
-      .map(dir.resolve(_)).toSeq
-    val memories = svFiles.filter(_.getFileName.toString.startsWith("mem_"))
+    val svFiles  = listedFiles(dir)
+    val memories = svFiles.filter(isMemory)
     val names = memories.map { f =>
       val (name, text) = rewriteModule(Files.readString(f), f.getFileName.toString)
       Files.writeString(f, text)
@@ -46,6 +45,15 @@ object SingleClockMemories {
       }
     names
   }
+
+  /** The SystemVerilog files `dir/filelist.f` lists (only those: firtool leaves older files of the folder alone). */
+  def listedFiles(dir: Path): Seq[Path] =
+    Files.readAllLines(dir.resolve("filelist.f")).asScala.map(_.trim).filter(_.endsWith(".sv")).map(dir.resolve(_)).toSeq
+
+  /** The memory modules firtool emits for `SyncReadMem`s: `mem_<depth>x<width>.sv`. */
+  def memoryFiles(dir: Path): Seq[Path] = listedFiles(dir).filter(isMemory)
+
+  private def isMemory(file: Path): Boolean = file.getFileName.toString.startsWith("mem_")
 
   private def rewriteModule(text: String, file: String): (String, String) = {
     val header = """(?s)module\s+(\w+)\s*\((.*?)\);""".r
