@@ -21,10 +21,16 @@ import chisel3.util._
   * that uses the previous contents: no extra port, no extra cycle.
   *
   * Block 0's A objects 0 .. m-1 never pass a B window. While loading, the B
-  * ports are free: the cycle after object k < m is written (memory k, row 0),
-  * B port k reads it back and `aNext(k)` captures it the same way. A run
-  * starts at the earliest one cycle after its last load, so these reads
-  * never meet an issue and land before block 0's first cycle does.
+  * ports are free: the cycle after object k < m reaches its row (memory k,
+  * row 0; the write port is registered, so two cycles after the load port
+  * took it), B port k reads it back and `aNext(k)` captures it the same way.
+  * A run starts at the earliest one cycle after its last load, so its first
+  * issue comes two cycles after that load at the earliest. Only the
+  * read-back of the last box loaded can meet it; the issue's read wins, and
+  * nothing is lost: that read-back happens then only when every box loaded
+  * is in block 0, and the last of them is never an A object that is
+  * compared (no object follows it). Every other read-back lands before
+  * block 0's first cycle does.
   *
   * No A register has a multiplexer in front of it: `aNext(k)` loads from
   * memory k's read data, `aBlock` from `aNext` (clock enables only).
@@ -45,18 +51,19 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   sequencer.io.advance := advance
   val issue = sequencer.io.issue
 
-  // Read back block 0's A objects the cycle after they are written.
-  val loadRead = RegNext(Mux(io.write.valid, io.write.bits.firstBlockLane, 0.U), 0.U(m.W))
+  // The writes as the memories see them, CoordBuffer.writeLatency cycles later.
+  val memoryWrite = Wire(Valid(UInt(m.W))) // bits: block 0's one-hot lane
+  memoryWrite.valid := ShiftRegister(io.write.valid, CoordBuffer.writeLatency, false.B, true.B)
+  memoryWrite.bits  := ShiftRegister(Mux(io.write.valid, io.write.bits.firstBlockLane, 0.U), CoordBuffer.writeLatency, 0.U, true.B)
+  // Read back block 0's A objects the cycle after they reach their row.
+  val loadRead = RegNext(memoryWrite.bits, 0.U(m.W))
   // readsNeverMeetWrites: no read whose data is used meets a write of the same
   // memory row in the same cycle, which lets the emitted memories drop the
   // block RAM's collision bypass (NoCollisionMemories). Runs never overlap
-  // loads, and block 0's read-back comes the cycle after its write.
-  assert(!(io.write.valid && sequencer.io.active), "a box was written while a run read the memories")
+  // the memories' writes, and block 0's read-back comes the cycle after its write.
+  assert(!(memoryWrite.valid && sequencer.io.active), "a box was written while a run read the memories")
   for (k <- 0 until m)
-    assert(
-      !(loadRead(k) && io.write.valid && io.write.bits.firstBlockLane(k)),
-      "a block-0 read-back met a write of its row"
-    )
+    assert(!(loadRead(k) && memoryWrite.bits(k)), "a block-0 read-back met a write of its row")
   // While idle every port reads row 0.
   val readRows = VecInit(issue.bits.bRows.map(r => Mux(sequencer.io.active, r, 0.U)))
   buffer.io.readEnable := sequencer.io.active || loadRead.orR
@@ -90,7 +97,8 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
     val tags  = Vec(m, UInt(tagWidth.W))
   }
   val capture = Wire(new Capture)
-  capture.lanes := Mux(issue.valid, issue.bits.capture, loadRead)
+  // While a run is active its rows are read: a read-back that meets it is dropped (see above).
+  capture.lanes := Mux(sequencer.io.active, Mux(issue.valid, issue.bits.capture, 0.U), loadRead)
   capture.tags  := tags(portObjects)
 
   // Memory read (1 cycle), then the memory output registers; the buffer's

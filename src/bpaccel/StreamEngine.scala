@@ -42,10 +42,21 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   }
   private def tagOf(index: UInt): UInt = if (p.debugPort) index else 0.U(0.W)
 
+  // ---- the loaded boxes, registered: for the memory's write port and the window ----
+  // Sampled every cycle, valid or not (every use checks the valid): Pipe's
+  // enable put the load port's valid-and-ready in front of these 200
+  // flip-flops (stream m = 64's critical path, 72.2 MHz, 12.6 ns routing).
+  // The memory's write port takes them from here too: the load handshake
+  // drove its write enable directly (stream m = 32's critical path,
+  // 101.0 MHz: load ready -> the block RAMs' write enable, 8.5 ns of wire).
+  val loadedBox = Wire(Valid(new LoadWrite(p)))
+  loadedBox.valid := RegNext(io.write.valid, false.B)
+  loadedBox.bits  := RegNext(io.write.bits)
+
   // ---- coordinate memory: one row of six keys per object (its read is below) ----
   // Top-level vals, so the memory keeps its plain name (module mem_<rows>x<width>).
   val mem = Option.when(p.memoryStyle == MemoryStyle.Inferred)(SyncReadMem(p.capacity, UInt(W.W)))
-  for (mem <- mem) when(io.write.valid) { mem.write(io.write.bits.index, io.write.bits.box.asUInt) }
+  for (mem <- mem) when(loadedBox.valid) { mem.write(loadedBox.bits.index, loadedBox.bits.box.asUInt) }
   val registeredMem =
     Option.when(p.memoryStyle == MemoryStyle.Ecp5OutputRegister)(Module(new RegisteredReadMemory(p.capacity, W)))
 
@@ -111,9 +122,11 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     } // past the last block the stream is never compared: hold
   }
   // readsNeverMeetWrites: the memory is read only while a run is active and
-  // written only while none is, so no read meets a write of its row, which
-  // lets the emitted memory drop the block RAM's collision bypass (NoCollisionMemories).
-  assert(!(io.write.valid && readEvent), "a box was written while the stream read the memory")
+  // written only while none is (a run's first read comes two cycles after
+  // its last box was taken, its write one), so no read meets a write of its
+  // row, which lets the emitted memory drop the block RAM's collision bypass
+  // (NoCollisionMemories).
+  assert(!(loadedBox.valid && readEvent), "a box was written while the stream read the memory")
   // ---- the memory's read ----
   val read = Wire(Valid(new Entry))
   read.valid    := RegNext(readEvent, false.B)
@@ -124,9 +137,9 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       read.bits.box := mem.read(rObj, readEvent)
       Seq.iterate(read, p.memoryOutputStages + 1)(x => Pipe(x))
     case (_, Some(mem)) =>
-      mem.io.writeEnable := io.write.valid
-      mem.io.writeRow    := io.write.bits.index
-      mem.io.writeData   := io.write.bits.box.asUInt
+      mem.io.writeEnable := loadedBox.valid
+      mem.io.writeRow    := loadedBox.bits.index
+      mem.io.writeData   := loadedBox.bits.box.asUInt
       mem.io.readEnable  := readEvent
       mem.io.readRow     := rObj
       read.bits.box := DontCare // only inside the memory
@@ -156,7 +169,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // ---- the window: lane k holds object s+k ----
   val window = Reg(Vec(m, new Entry))
   // Objects 0 .. m shift in as they are loaded, one cycle after the load
-  // port took them: the load's valid and ready would otherwise reach the
+  // port took them (`loadedBox`): the load's valid and ready would otherwise reach the
   // window's enables through the port logic (the m = 8 critical path once
   // the load-ready was a register). The last box shifts in at the latest in
   // the cycle of the launch, and the window is not used before the cycle
@@ -165,12 +178,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // holds that count as a thermometer, bit k set while it is more than k, so
   // that counting one down is a shift and the look-ahead of the window's
   // enables reads single bits instead of a subtraction (stream m = 64).
-  // Sampled every cycle, valid or not (every use checks the valid): Pipe's
-  // enable put the load port's valid-and-ready in front of these 200
-  // flip-flops (stream m = 64's critical path, 72.2 MHz, 12.6 ns routing).
-  val loadedBox  = Wire(Valid(new LoadWrite(p)))
-  loadedBox.valid := RegNext(io.write.valid, false.B)
-  loadedBox.bits  := RegNext(io.write.bits)
   val owesAll    = ((BigInt(1) << (m + 1)) - 1).U((m + 1).W) // m+1 shifts owed: a start
   val owes       = RegInit(owesAll)
   val takesLoads = owes(0)
@@ -222,10 +229,19 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // m = 64's critical path, 82.1 MHz).
   val loadedTop = VecInit(Seq.tabulate(m)(k => RegNext(loadShift && loadedBox.bits.firstBlockLane(k), false.B)))
   // Later blocks: cycle k of a block finds object base+m+k in the top lane.
-  val capture = Reg(UInt(m.W)) // one-hot: lane of aNext to fill at this issue
-  for (k <- 0 until m) {
-    when((issue && capture(k)) || loadedTop(k)) { aNext(k) := window(m - 1) }
-  }
+  val capture     = Reg(UInt(m.W)) // one-hot: lane of aNext to fill at this issue
+  val captureNext = WireDefault(capture)
+  capture := captureNext
+  // Each lane's enable is a register computed a cycle ahead, as the window's
+  // and the A block's are: `issuing` reached lane k's 192 enables through
+  // issue && capture(k) (stream m = 64's critical path, 83.7 MHz, 11.0 ns of wire).
+  val aNextLoad = laneEnables(
+    "aNextLoad",
+    next = Seq.tabulate(m)(k =>
+      (issuingNext && io.room && captureNext(k)) || (loadShift && loadedBox.bits.firstBlockLane(k))),
+    now = Seq.tabulate(m)(k => (issue && capture(k)) || loadedTop(k))
+  )
+  for (k <- 0 until m) when(aNextLoad(k)) { aNext(k) := window(m - 1) }
 
   // ---- the schedule ----
   val base      = Reg(UInt(p.countWidth.W))
@@ -279,7 +295,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       left     := left - 1.U
       leftIsOne := left === 2.U
       blockEndCarry := leftIsOne
-      capture  := (capture << 1)(m - 1, 0)
+      captureNext := (capture << 1)(m - 1, 0)
     }.elsewhen(hasNextBlock) {
       base         := base + m.U
       s            := base + (m + 1).U
@@ -290,7 +306,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       blockLeftAtLeast2m := blockLeft >= (3 * m).U
       blockEndCarry     := blockLeftIsM
       hasNextBlockCarry := blockLeftAtLeast2m
-      capture      := 1.U
+      captureNext  := 1.U
     }.otherwise {
       issuingNext := false.B
     }
@@ -316,7 +332,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     blockLeftAtLeast2m := count >= (2 * m + 2).U
     blockEndNext     := count === 2.U
     hasNextBlockNext := count >= (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 3 else 2)).U
-    capture   := 1.U
+    captureNext := 1.U
     rBase      := 0.U
     rBlockLeft := count - 2.U
     // R[m] is block 0's object m+1 when it exists; otherwise no later block
@@ -378,9 +394,13 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     * told otherwise; the FPGA flow keeps the copies by name (docs/fpga.md).
     */
   private def replicatedEnable(name: String, next: Bool, now: Bool): Seq[Bool] =
-    Seq.tabulate(m) { k =>
-      val copy = RegNext(next, false.B).suggestName(s"${name}_replica$k")
-      assert(copy === now || unlaunchedStart, s"the look-ahead of $name is wrong")
+    laneEnables(name, Seq.fill(m)(next), Seq.fill(m)(now))
+
+  /** [[replicatedEnable]] with an enable of its own for each lane. */
+  private def laneEnables(name: String, next: Seq[Bool], now: Seq[Bool]): Seq[Bool] =
+    next.zip(now).zipWithIndex.map { case ((nextK, nowK), k) =>
+      val copy = RegNext(nextK, false.B).suggestName(s"${name}_replica$k")
+      assert(copy === nowK || unlaunchedStart, s"the look-ahead of $name is wrong")
       copy
     }
 

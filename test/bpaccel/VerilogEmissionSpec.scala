@@ -103,6 +103,36 @@ class VerilogEmissionSpec extends AnyFlatSpec with Matchers {
         }
     }
 
+  /** The write-port connections of every coordinate memory instance in `text` (not the
+    * queues' small RAMs): (port, what it is connected to).
+    */
+  private def memoryWritePorts(text: String): Seq[(String, String)] =
+    s"""(?s)\\b(?:mem_|${RegisteredReadMemory.namePrefix})\\w+\\s+\\w+\\s*\\((.*?)\\n\\s*\\);""".r
+      .findAllMatchIn(text).toSeq.flatMap(instance =>
+        """\.(W0_en|W0_addr|W0_data|io_writeEnable|io_writeRow|io_writeData)\s*\(([^()]*)\)""".r
+          .findAllMatchIn(instance.group(1)).map(x => (x.group(1), x.group(2).trim)))
+
+  /** Names declared as `reg` in `text`. */
+  private def registerNames(text: String): Set[String] =
+    """(?m)^\s*reg\s*(?:\[[^\]]+\])?\s*(\w+)\s*;""".r.findAllMatchIn(text).map(_.group(1)).toSet
+
+  // The load handshake must not reach the block RAMs' write ports through
+  // logic: a registered write port took it off seed m = 8's and stream
+  // m = 32's critical paths (docs/fpga.md).
+  for (arch <- Arch.all; m <- Seq(1, 3, 8))
+    it should s"drive every memory write port of the ${arch.name} architecture straight from registers, m=$m" in {
+      val (_, dir) = emitted(m, arch, capacity = Some(24 * m))
+      val users = svFiles(dir).filterNot(_.startsWith("mem_")).filterNot(_.startsWith(RegisteredReadMemory.namePrefix))
+      val ports = users.flatMap(f => memoryWritePorts(read(dir, f)).map(f -> _))
+      ports.map(_._2._1).toSet should contain atLeastOneOf ("W0_en", "io_writeEnable")
+      for ((f, (port, signal)) <- ports) withClue(s"$f: .$port($signal): ") {
+        // A bare register or a concatenation of registers: no gate between them and the port.
+        val names = """[A-Za-z_]\w*""".r.findAllIn(signal).toSeq
+        signal should fullyMatch regex """\{?\s*[A-Za-z_]\w*(\s*,\s*[A-Za-z_]\w*)*\s*\}?"""
+        registerNames(read(dir, f)) should contain allElementsOf names
+      }
+    }
+
   it should "refuse to mark a memory module whose array it does not recognise" in {
     val (p, dir) = emitted(1)
     val mem = dir.resolve(s"mem_${p.depth}x${p.keyWidth}.sv")
