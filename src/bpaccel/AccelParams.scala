@@ -136,11 +136,12 @@ case class AccelParams(
   val readLatency: Int = 1 + memoryOutputStages
 
   /** Cycles from an issue to its hit mask at the result queue. Seed: memory
-    * read, memory output registers, rotator register, comparator register.
-    * Stream: the operands are already registers; comparator register, AND register.
+    * read, memory output registers, rotator register, comparator register, AND
+    * register. Stream: the operands are already registers; comparator
+    * register, AND register.
     */
   val pipelineLatency: Int = arch match {
-    case Arch.Seed   => 1 + memoryOutputStages + 2
+    case Arch.Seed   => 1 + memoryOutputStages + 3
     case Arch.Stream => 2
   }
 

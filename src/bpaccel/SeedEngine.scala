@@ -8,7 +8,7 @@ import chisel3.util._
   *
   * Pipeline, one schedule cycle per clock when unstalled:
   * issue -> memory read -> memory output registers -> rotator register ->
-  * comparator/AND register. The sequencer only issues when the top level
+  * comparator register -> AND register. The sequencer only issues when the top level
   * grants a credit (`advance`), so the pipeline itself never stalls.
   *
   * Each memory has a single read port, busy with the B window every cycle, so
@@ -128,17 +128,16 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   // Rotator, registered; the A block is already a register.
   val rotatedB  = RegNext(Rotator(memData, atBuffered.bits.rotate))
   val atRotated = Pipe(atBuffered)
-  // Comparators and AND gates, registered.
+  // Comparators, registered; then the AND gates and any-hit, registered (as the stream).
   compare.io.a := aBlock
   compare.io.b := rotatedB
-  // Any hit from the registered mask: the seed compares and ANDs in one stage,
-  // and its OR there (as the stream does) made that stage the critical path
-  // (seed m = 8, 97.0 MHz: rotator register -> compare -> AND -> OR, 9 LUT levels).
-  val hitMask   = RegNext(compare.io.hits & atRotated.bits.laneMask)
-  val atCompare = Pipe(atRotated)
-  val probeI    = RegNext(aBlockTag)
+  val compared   = RegNext(compare.io.compares)
+  val atCompared = Pipe(atRotated)
+  val (hitMask, anyHit) = hitRegisters(ComparatorArray.hits(compared) & atCompared.bits.laneMask)
+  val atAnd  = Pipe(atCompared)
+  val probeI = RegNext(RegNext(aBlockTag))
 
-  val stages = memoryStages.map(_._1) ++ Seq(atRotated, atCompare)
+  val stages = memoryStages.map(_._1) ++ Seq(atRotated, atCompared, atAnd)
   require(stages.length == p.pipelineLatency)
 
   io.activity.active   := sequencer.io.active
@@ -147,5 +146,5 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   io.activity.inFlight := PopCount(stages.map(_.valid))
   io.activity.retired  := stages.last.valid
 
-  emit(atCompare.valid, atCompare.bits.iBase, atCompare.bits.jBase, atCompare.bits.laneMask, probeI, atCompare.bits.probeJ, hitMask, hitMask.orR)
+  emit(atAnd.valid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, probeI, atAnd.bits.probeJ, hitMask, anyHit)
 }

@@ -369,15 +369,12 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   }
   private def boxOf(e: Entry): Aabb = e.box.asTypeOf(new Aabb(p.keyWidth))
   // Six comparator results per lane, registered before the AND.
-  val compared = RegNext(VecInit(a.zip(window).map { case (ea, eb) =>
-    val (x, y) = (boxOf(ea), boxOf(eb))
-    VecInit((0 until 3).flatMap(axis =>
-      if (p.has(Fault.StrictCompare)) Seq(x.min(axis) < y.max(axis), x.max(axis) > y.min(axis))
-      else Seq(x.min(axis) <= y.max(axis), x.max(axis) >= y.min(axis))
-    )).asUInt
-  }))
+  val compare = Module(new ComparatorArray(p))
+  compare.io.a := VecInit(a.map(boxOf))
+  compare.io.b := VecInit(window.map(boxOf))
+  val compared = RegNext(compare.io.compares)
   val atCompare = Pipe(issue, meta)
-  val (hitMask, anyHit) = hitRegisters(VecInit(compared.map(_.andR)).asUInt & atCompare.bits.laneMask)
+  val (hitMask, anyHit) = hitRegisters(ComparatorArray.hits(compared) & atCompare.bits.laneMask)
   val atAnd     = Pipe(atCompare)
   require(p.pipelineLatency == 2)
 

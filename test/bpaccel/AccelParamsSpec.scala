@@ -47,8 +47,8 @@ class AccelParamsSpec extends AnyFlatSpec with Matchers {
   }
 
   it should "count every register of the pipeline in its latency" in {
-    AccelParams(memoryOutputStages = 0).pipelineLatency shouldBe 3
-    AccelParams().pipelineLatency shouldBe 5
+    AccelParams(memoryOutputStages = 0).pipelineLatency shouldBe 4
+    AccelParams().pipelineLatency shouldBe 6
   }
 
   it should "reject a result queue too shallow to keep the pipeline streaming" in {

@@ -19,17 +19,16 @@ object FormalConfigs {
     * output registers, so a run starts one cycle after its start.
     */
   def params(arch: Arch, m: Int, capacity: Int, keyWidth: Int = 1): AccelParams = {
-    val latency = arch match { case Arch.Seed => 1 + 0 + 2; case Arch.Stream => 2 }
-    AccelParams(
+    val p = AccelParams(
       m = m,
       capacity = capacity,
       keyWidth = keyWidth,
-      resultQueueDepth = latency + 3,
       memoryOutputStages = 0,
       debugPort = true,
       arch = arch,
       counterWidth = 4
     )
+    p.copy(resultQueueDepth = p.pipelineLatency + 3)
   }
 
   /** Cycles from reset to `done` of a run of n objects whose consumer never
