@@ -387,12 +387,22 @@ void BroadPhase::Worker::keepPairs(std::span<const Pair> pairs, std::span<const 
                                    std::span<const KeyBox> packed, std::span<const std::uint8_t> below,
                                    const Cell* region, std::size_t splitAt, int keep) {
   if (!below.empty() && keep == kFirstInside && splitAt == items.size()) {
-    // One run of the whole cell: every pair is an inside pair of the first chunk.
+    // One run of the whole cell: every pair is an inside pair of the first
+    // chunk. Written branch-free through a local cursor into room made
+    // first (about a sixth of the hits are owned by another cell, at
+    // random: a branch would mispredict), then the room not used is cut.
+    const std::size_t at = out.size();
+    out.resize(at + pairs.size());
+    Pair* const to = out.data() + at;
+    std::size_t kept = 0;
+    const std::uint8_t* const bits = below.data();
+    const std::uint32_t* const ids = items.data();
     for (const auto& [a, b] : pairs) {
-      if (!ownsPair(below[a], below[b])) continue;
-      const std::uint32_t i = items[a], j = items[b];
-      out.emplace_back(std::min(i, j), std::max(i, j));
+      const std::uint32_t i = ids[a], j = ids[b];
+      to[kept] = {std::min(i, j), std::max(i, j)};
+      kept += static_cast<std::size_t>(ownsPair(bits[a], bits[b]));
     }
+    out.resize(at + kept);
     return;
   }
   for (const auto& [a, b] : pairs) {
