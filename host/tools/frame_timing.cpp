@@ -14,6 +14,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <new>
 #include <memory>
 #include <vector>
 
@@ -25,6 +27,18 @@
 #include "exact_pairs.hpp"
 #include "rtl_backend.hpp"
 #include "scene.hpp"
+
+// Heap allocations, counted to report those a frame makes (a frame should
+// reuse its buffers). Global only in this driver, for the replaced operator new.
+std::size_t gAllocations = 0;
+
+void* operator new(std::size_t size) {
+  ++gAllocations;
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -77,17 +91,19 @@ int main(int argc, char** argv) {
   bpaccel::BroadPhase phase(*backend, cellSize, cellsPerBatch, bpaccel::parsePartitionKind(partition));
 
   std::vector<char> flood(evict ? 64u << 20 : 0);
-  std::vector<double> host, convert, part, cells, decode;
+  std::vector<double> host, convert, part, cells, decode, allocations;  // allocations: after the first pass
   std::vector<bpaccel::Pair> pairs;
   unsigned sink = 0;
   for (std::size_t p = 0; p < passes; ++p) {
     for (std::size_t f = 0; f < frames; ++f) {
       for (std::size_t b = 0; b < flood.size(); b += 64) sink += static_cast<unsigned char>(++flood[b]);
+      const std::size_t allocationsBefore = gAllocations;
       const auto t0 = Clock::now();
       phase.findPairs(recorded[f], pairs);
       const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
       const auto& t = phase.times();
       host.push_back(wall - t.backendSeconds);
+      if (p > 0) allocations.push_back(static_cast<double>(gAllocations - allocationsBefore));
       convert.push_back(t.convertSeconds);
       part.push_back(t.partitionSeconds);
       cells.push_back(t.cellsSeconds - t.backendSeconds);
@@ -105,7 +121,7 @@ int main(int argc, char** argv) {
   const auto us = [](const std::vector<double>& v) { return median(v) * 1e6; };
   fmt::print("objects {} partition {} cell {} cells/batch {} backend {} frames {} evict {} (sink {})\n", objects,
              partition, cellSize, cellsPerBatch, backend->name(), host.size(), evict, sink & 1);
-  fmt::print("host_us {:.1f} convert_us {:.1f} partition_us {:.1f} cells_host_us {:.1f} (decode_us {:.1f}) pairs {} hits {} runs {} batches {}\n",
-             us(host), us(convert), us(part), us(cells), us(decode), pairs.size(), phase.stats().hits, phase.stats().runs, phase.stats().batches);
+  fmt::print("host_us {:.1f} convert_us {:.1f} partition_us {:.1f} cells_host_us {:.1f} (decode_us {:.1f}) pairs {} hits {} runs {} batches {} allocations/frame {}\n",
+             us(host), us(convert), us(part), us(cells), us(decode), pairs.size(), phase.stats().hits, phase.stats().runs, phase.stats().batches, median(allocations));
   return 0;
 }
