@@ -475,11 +475,10 @@ void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, con
   std::uint8_t* const below = itemBelow_.data();
   KeyBox* const packed = packed_.data();
   const std::uint32_t* const firsts = firstCell_.data();
-  for (std::size_t i = 0; i < boxes.size(); ++i) {
-    const std::uint64_t at = cursor[firsts[i]]++;
-    items[at] = static_cast<std::uint32_t>(i);
-    below[at] = 0;
-  }
+  // A box in its first cell lies below it on no axis: those bits are cleared
+  // in one sweep, not written one by one beside the items.
+  std::fill(below, below + total, std::uint8_t{0});
+  for (std::size_t i = 0; i < boxes.size(); ++i) items[cursor[firsts[i]]++] = static_cast<std::uint32_t>(i);
   for (const Extra& e : std::span<const Extra>(extras_).first(extraCount_)) {
     const std::uint64_t at = cursor[e.cell]++;
     items[at] = e.id;
