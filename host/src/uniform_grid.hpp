@@ -38,7 +38,7 @@ namespace bpaccel {
 ///
 /// A box's cell on an axis is computed, not looked up: cell(key) =
 /// clamp(trunc((value(key) / 2 - from / 2) * scale), 0, cells - 1) in float
-/// arithmetic, four keys at a time with SSE2 (value: the key's float,
+/// arithmetic, eight keys at a time with AVX2 or four with SSE2 (value: the key's float,
 /// clamped to the finite ones; the halves keep the difference finite). Each
 /// step is monotone in the key (IEEE rounding is), so cell(key) never
 /// decreases and a cell's region is exactly the keys that map to it; its

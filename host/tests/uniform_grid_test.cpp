@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numeric>
 #include <optional>
 #include <random>
 
@@ -176,6 +177,55 @@ TEST(UniformGrid, HandsItsCellsOverAtTheEndWhileTheTreeStreamsThem) {
   EXPECT_TRUE(KdTree().streamsCells()) << "the tree's first leaf goes to the device before the tree is done";
   EXPECT_TRUE(KdTree().below(Cell{}).empty());
   EXPECT_TRUE(KdTree().packed(Cell{}).empty());
+}
+
+TEST(UniformGrid, CellsDoNotDependOnWhichLoopComputedABox) {
+  // Four boxes a step with AVX2, then two with SSE2, then one by one: a
+  // scene of 4k + 3 boxes, rotated and reversed, sends each box through
+  // other loops and lanes. The bounds and n stay, so the planes do, and each
+  // cell must hold the same boxes with the same below() bits.
+  std::vector<Aabb> boxes = scatteredBoxes(403, 21, -40, 40, 0.5f, 6);
+  boxes[5] = box(-30, -30, -30, 30, 2, 3);  // spans more than two cells an axis
+  std::vector<KeyBox> keys;
+  toKeys(boxes, keys);
+  UniformGrid reference;
+  reference.build(keys, 16, {});
+  ASSERT_FALSE(reference.fellBack());
+  // Per cell: (box, below bits), sorted.
+  const auto contents = [](const UniformGrid& grid, const std::vector<std::uint32_t>& original) {
+    std::vector<std::vector<std::pair<std::uint32_t, std::uint8_t>>> cells;
+    for (const Cell& c : grid.cells()) {
+      auto& held = cells.emplace_back();
+      for (std::size_t t = 0; t < c.count; ++t) held.emplace_back(original[grid.items(c)[t]], grid.below(c)[t]);
+      std::sort(held.begin(), held.end());
+    }
+    return cells;
+  };
+  std::vector<std::uint32_t> identity(keys.size());
+  std::iota(identity.begin(), identity.end(), 0u);
+  const auto expected = contents(reference, identity);
+  std::size_t straddled = 0;
+  for (const auto& held : expected)
+    for (const auto& [id, bits] : held) straddled += bits != 0;
+  ASSERT_GT(straddled, 50u) << "the scene must have straddlers";
+  for (int variant = 1; variant <= 4; ++variant) {
+    std::vector<std::uint32_t> original = identity;  // original[new index] = old index
+    if (variant < 4)
+      std::rotate(original.begin(), original.begin() + variant, original.end());
+    else
+      std::reverse(original.begin(), original.end());
+    std::vector<KeyBox> moved(keys.size());
+    for (std::size_t t = 0; t < keys.size(); ++t) moved[t] = keys[original[t]];
+    UniformGrid grid;
+    grid.build(moved, 16, {});
+    ASSERT_FALSE(grid.fellBack());
+    ASSERT_EQ(grid.cells().size(), reference.cells().size()) << variant;
+    for (std::size_t c = 0; c < grid.cells().size(); ++c) {
+      EXPECT_EQ(grid.cells()[c].lo, reference.cells()[c].lo) << variant;
+      EXPECT_EQ(grid.cells()[c].hi, reference.cells()[c].hi) << variant;
+    }
+    EXPECT_EQ(contents(grid, original), expected) << "variant " << variant;
+  }
 }
 
 TEST(UniformGrid, AimsAtTwoNOverCellSizeCellsOnAUniformScene) {
