@@ -87,8 +87,9 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // room for them, and each issue takes one entry. Reading starts with the
   // run, so the first object reaches the queue readLatency cycles later, and
   // the reader then stays ahead: an issue always finds its object there.
-  // Its head is a register, not a LUT RAM read at a pointer (HeadRegisterQueue).
-  val readQueue = Module(new HeadRegisterQueue(new Entry, p.readLatency + 2))
+  val readQueue = Module(
+    new Queue(new Entry, p.readLatency + 2, flow = true, hasFlush = true)
+  )
   val readsInFlight = Wire(UInt(log2Ceil(p.readLatency + 1).W))
   // Queue slots not yet taken or claimed by a read in flight, kept as a
   // register: comparing the queue's count plus the reads in flight with its
