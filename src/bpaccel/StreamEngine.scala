@@ -80,6 +80,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val startingCarry = WireDefault(starting)
   val fillingCarry  = WireDefault(filling)
   val issuingNext   = WireDefault(issuing)
+  val issueNext     = issuingNext && io.room // `issue` in the next cycle (advance is io.room registered)
 
   // ---- read side: the stream R from R[m] on, read ahead into a small queue ----
   // The memory and its output registers run freely (no enable, no
@@ -224,10 +225,12 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // The last box of a run may shift in at the launch, so its capture may come
   // after the startup copied aNext into a: harmless, as object n-1 is never
   // an A object that is compared (no object follows it).
-  // One register per lane, from the loader's one-hot lane: the compare of
-  // the loaded index with k sat in front of lane k's 192 enables (stream
-  // m = 64's critical path, 82.1 MHz).
-  val loadedTop = VecInit(Seq.tabulate(m)(k => RegNext(loadShift && loadedBox.bits.firstBlockLane(k), false.B)))
+  // Decoded per lane from the loader's one-hot lane, not by comparing the
+  // loaded index with k (that compare sat in front of lane k's 192 enables:
+  // stream m = 64's critical path, 82.1 MHz). `loadedTop` is the capture as
+  // it happens, the reference the look-ahead below is checked against.
+  val loadsTopNext = Seq.tabulate(m)(k => loadShift && loadedBox.bits.firstBlockLane(k))
+  val loadedTop    = loadsTopNext.map(RegNext(_, false.B))
   // Later blocks: cycle k of a block finds object base+m+k in the top lane.
   val capture     = Reg(UInt(m.W)) // one-hot: lane of aNext to fill at this issue
   val captureNext = WireDefault(capture)
@@ -237,8 +240,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // issue && capture(k) (stream m = 64's critical path, 83.7 MHz, 11.0 ns of wire).
   val aNextLoad = laneEnables(
     "aNextLoad",
-    next = Seq.tabulate(m)(k =>
-      (issuingNext && io.room && captureNext(k)) || (loadShift && loadedBox.bits.firstBlockLane(k))),
+    next = Seq.tabulate(m)(k => (issueNext && captureNext(k)) || loadsTopNext(k)),
     now = Seq.tabulate(m)(k => (issue && capture(k)) || loadedTop(k))
   )
   for (k <- 0 until m) when(aNextLoad(k)) { aNext(k) := window(m - 1) }
@@ -276,7 +278,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // The A block is copied from aNext through the startup and at each block change.
   val aLoad = replicatedEnable(
     "aLoad",
-    next = startingSoon || (issuingNext && io.room && blockEndCarry && hasNextBlockCarry),
+    next = startingSoon || (issueNext && blockEndCarry && hasNextBlockCarry),
     now = starting || (issue && blockEnd && hasNextBlock)
   )
   for (k <- 0 until m) when(aLoad(k)) { a(k) := aNext(k) }
