@@ -12,6 +12,14 @@ std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m) {
   return blocks * (n - 1) - m * blocks * (blocks - 1) / 2;
 }
 
+std::size_t batchLoadIndex(std::size_t position, std::size_t n, std::size_t m, std::size_t capacity,
+                           bool overlapsLoads) {
+  const bool headLast = overlapsLoads && n >= m + 2 && n <= capacity;
+  if (!headLast) return position;
+  const std::size_t tail = n - m - 1;  // objects m+1 .. n-1, sent first
+  return position < tail ? m + 1 + position : position - tail;
+}
+
 void Backend::runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
                        std::vector<std::size_t>& cellEnds, RunStats& stats) {
   for (const auto& cell : cells) {
@@ -21,12 +29,13 @@ void Backend::runBatch(std::span<const std::span<const KeyBox>> cells, std::vect
 }
 
 ModelBackend::ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles,
-                           std::uint64_t streamReadLatency, std::size_t batchCells)
+                           std::uint64_t streamReadLatency, std::size_t batchCells, bool overlapsLoads)
     : m_(m),
       capacity_(capacity),
       overhead_(runOverheadCycles),
       streamReadLatency_(streamReadLatency),
-      batchCells_(batchCells) {
+      batchCells_(batchCells),
+      overlapsLoads_(overlapsLoads) {
   // Only the seed architecture stripes objects over m memories.
   if (m == 0 || capacity < 2 || (streamReadLatency == 0 && capacity % m != 0))
     throw std::invalid_argument(fmt::format("model: invalid m = {} / capacity = {}", m, capacity));
@@ -46,13 +55,16 @@ void ModelBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std:
       throw std::length_error(fmt::format("model: a cell of {} boxes exceeds the capacity {}", cell.size(), capacity_));
   for (std::size_t first = 0; first < cells.size(); first += batchCells_) {
     const auto batch = cells.subspan(first, std::min(batchCells_, cells.size() - first));
+    RunStats cells;
     for (const auto& cell : batch) {
-      runCell(cell, out, stats);
+      runCell(cell, out, cells);
       cellEnds.push_back(out.size());
     }
-    // The front end: the cycle that takes the batch's first count, and per cell the cycle that ends it.
-    stats.loadCycles += 1;
-    stats.cycles += batch.size();
+    // The cycles come from the batch's timeline, not from its cells one by one.
+    cells.loadCycles = 0;
+    cells.cycles = 0;
+    batchCycles(batch, cells);
+    stats += cells;
     stats.runs += batch.size();
     stats.batches += 1;
   }
@@ -78,17 +90,54 @@ void ModelBackend::runCell(std::span<const KeyBox> boxes, std::vector<Pair>& out
       beats += hit;
     }
   }
-  const std::uint64_t issue = scheduleIssueCycles(n, m_);
-  // Stream: the window must hold objects 1..m (n <= m: m+1-n shifts after the
-  // load) while the first reads reach its entry.
-  const std::uint64_t startup =
-      n < 2 || streamReadLatency_ == 0 ? 0 : std::max<std::uint64_t>(m_ + 1 > n ? m_ + 1 - n : 0, streamReadLatency_);
   stats.loadCycles += n + 1;  // one box a cycle, then the start cycle
-  stats.issueCycles += issue;
-  stats.cycles += n < 2 ? 0 : startup + issue + overhead_;
+  stats.issueCycles += scheduleIssueCycles(n, m_);
+  stats.cycles += busyCycles(n);
   stats.hits += out.size() - before;
   stats.boxesSent += n;
   stats.beatsReceived += beats;
+}
+
+std::uint64_t ModelBackend::startupCycles(std::uint64_t n) const {
+  // Stream: the window must hold objects 1..m (n <= m: m+1-n shifts after the
+  // load) while the first reads reach its entry.
+  if (n < 2 || streamReadLatency_ == 0) return 0;
+  return std::max<std::uint64_t>(m_ + 1 > n ? m_ + 1 - n : 0, streamReadLatency_);
+}
+
+std::uint64_t ModelBackend::busyCycles(std::uint64_t n) const {
+  return n < 2 ? 0 : startupCycles(n) + scheduleIssueCycles(n, m_) + overhead_;
+}
+
+void ModelBackend::batchCycles(std::span<const std::span<const KeyBox>> batch, RunStats& stats) const {
+  // Cycle 0 takes the first count; every count and box is offered as soon as
+  // the device can take it, and the consumer never stalls.
+  std::uint64_t countTaken = 0;   // the cycle the device takes the cell's count
+  std::uint64_t windowFree = 0;   // first cycle objects 0..m may enter (the last run stopped issuing)
+  std::uint64_t nextStart = 0;    // earliest start: the cycle after the last cell ended
+  std::uint64_t end = 0, run = 0;
+  for (const auto& cell : batch) {
+    const std::uint64_t n = cell.size();
+    std::uint64_t lastBox = countTaken;
+    for (std::uint64_t position = 0; position < n; ++position) {
+      // A box past the capacity is refused and numbers nothing, so it counts as the last one taken.
+      const std::uint64_t object = std::min<std::uint64_t>(
+          batchLoadIndex(position, n, m_, capacity_, overlapsLoads_), capacity_);
+      const bool entersWindow = overlapsLoads_ && object <= m_;
+      lastBox = std::max(lastBox + 1, entersWindow ? windowFree : 0);
+    }
+    const std::uint64_t start = std::max(lastBox + 1, nextStart);
+    const bool launched = n >= 2 && n <= capacity_;
+    const std::uint64_t busy = launched ? busyCycles(n) : 0;
+    if (launched) windowFree = start + startupCycles(n) + scheduleIssueCycles(n, m_) + 1;
+    end = start + busy + 1;  // the front end's own cycle ends the cell
+    run += busy + 1;
+    nextStart = end + 1;
+    // The next count: at this start where loads overlap runs, else when this cell ends.
+    countTaken = overlapsLoads_ ? start : end;
+  }
+  stats.cycles += run;
+  stats.loadCycles += end + 1 - run;
 }
 
 void CpuBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) {

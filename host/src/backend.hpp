@@ -33,6 +33,15 @@ class Backend {
                         std::vector<std::size_t>& cellEnds, RunStats& stats);
 };
 
+/// Which object of a batch's cell of n boxes the device takes at `position`.
+/// Where loads overlap runs (BPACCEL_BATCH_OVERLAPS_LOADS) a cell of
+/// m + 2 <= n <= capacity boxes is sent head last: objects m+1 .. n-1 go into
+/// the memory while the cell before still runs, then objects 0 .. m, which
+/// enter the device's B window. Every other cell, and every single run, is
+/// sent in index order. Must equal bpaccel.AccelParams.batchLoadIndex.
+std::size_t batchLoadIndex(std::size_t position, std::size_t n, std::size_t m, std::size_t capacity,
+                           bool overlapsLoads);
+
 /// The accelerator's schedule in closed form: issue cycles of one run of n
 /// objects with m lanes, sum over blocks b of (n - 1 - b*m); 0 for n < 2.
 /// Must equal bpaccel.Schedule.issueCycles in the generator (tests compare
@@ -47,11 +56,13 @@ std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m);
 /// stream's, max(m + 1 - n, streamReadLatency) (BPACCEL_READ_LATENCY, 0 for
 /// the seed's, so passing the header's values always models the hardware built).
 /// Batches of up to `batchCells` cells (BPACCEL_BATCH_CELLS) cost what the
-/// hardware's front end adds: one cycle per batch and one per cell.
+/// hardware's front end adds: one cycle per batch and one per cell; with
+/// `overlapsLoads` (BPACCEL_BATCH_OVERLAPS_LOADS) each cell loads while the
+/// one before runs, so its load cycles are only those no run hides.
 class ModelBackend final : public Backend {
  public:
   ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles,
-               std::uint64_t streamReadLatency = 0, std::size_t batchCells = 64);
+               std::uint64_t streamReadLatency = 0, std::size_t batchCells = 64, bool overlapsLoads = false);
   std::string name() const override { return "model"; }
   std::size_t capacity() const override { return capacity_; }
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
@@ -61,12 +72,18 @@ class ModelBackend final : public Backend {
  private:
   /// One cell's pairs and counters, without counting it as a run.
   void runCell(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) const;
+  /// Cycles before a run of n objects issues (0 for the seed), and all its busy cycles.
+  std::uint64_t startupCycles(std::uint64_t n) const;
+  std::uint64_t busyCycles(std::uint64_t n) const;
+  /// One hardware batch's load and run cycles, cell by cell on the device's timeline.
+  void batchCycles(std::span<const std::span<const KeyBox>> batch, RunStats& stats) const;
 
   std::size_t m_;
   std::size_t capacity_;
   std::uint64_t overhead_;
   std::uint64_t streamReadLatency_;  // 0: the seed architecture
   std::size_t batchCells_;
+  bool overlapsLoads_;
 };
 
 /// Software alone: all pairs of the batch with SIMD compares (AllPairsKernel),

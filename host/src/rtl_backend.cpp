@@ -72,6 +72,7 @@ RtlBackend::RtlBackend(std::function<bool(std::uint64_t)> consumerReady)
   check("read latency", top_->io_info_readLatency, BPACCEL_READ_LATENCY);
   check("batch cells", top_->io_info_batchCells, BPACCEL_BATCH_CELLS);
   check("cell tag width", top_->io_info_cellTagWidth, BPACCEL_CELL_TAG_WIDTH);
+  check("batch overlaps loads", top_->io_info_batchOverlapsLoads, BPACCEL_BATCH_OVERLAPS_LOADS);
 }
 
 RtlBackend::~RtlBackend() { top_->final(); }
@@ -84,7 +85,7 @@ std::string RtlBackend::architecture() { return BPACCEL_ARCH; }
 
 ModelBackend modelOfBuiltHardware() {
   return ModelBackend(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES, BPACCEL_READ_LATENCY,
-                      BPACCEL_BATCH_CELLS);
+                      BPACCEL_BATCH_CELLS, BPACCEL_BATCH_OVERLAPS_LOADS != 0);
 }
 
 void RtlBackend::settle() {
@@ -228,7 +229,9 @@ void RtlBackend::batchOnHardware(std::span<const std::span<const KeyBox>> cells,
     if (countOffered) top.io_cells_bits = static_cast<std::uint32_t>(cells[nextCount].size());
     const bool boxOffered = cell < cells.size();
     top.io_load_valid = boxOffered;
-    if (boxOffered) setBox(top, cells[cell][box]);
+    if (boxOffered)
+      setBox(top, cells[cell][batchLoadIndex(box, cells[cell].size(), BPACCEL_M, BPACCEL_CAPACITY,
+                                             BPACCEL_BATCH_OVERLAPS_LOADS != 0)]);
     const bool ready = consumerReady_(cycle);
     top.io_result_ready = ready;
     settle();

@@ -21,7 +21,10 @@ FrameTimeline modelPipeline(const std::vector<RunRecord>& runs, double hostSecon
     produceStart = ready;
 
     const double boxes = model.bytesPerBox * static_cast<double>(s.boxesSent) / model.bandwidthBytesPerSecond;
-    const double load = std::max(boxes, static_cast<double>(s.loadCycles) / model.clockHz);
+    // The port takes one box a cycle, partly under runs (overlapped loads);
+    // a link slower than that adds its shortfall in full.
+    const double port = static_cast<double>(s.boxesSent) / model.clockHz;
+    const double load = static_cast<double>(s.loadCycles) / model.clockHz + std::max(0.0, boxes - port);
     const double compute = static_cast<double>(s.cycles) / model.clockHz;
     const double results = model.bytesPerBeat * static_cast<double>(s.beatsReceived) / model.bandwidthBytesPerSecond;
     const double start = std::max({ready + model.latencySeconds, linkFree, deviceFree});

@@ -106,17 +106,40 @@ case class AccelParams(
   /** Rows of each of the m striped memories of the seed architecture. */
   val depth: Int = (capacity / m).max(1)
 
-  /** Rows of each coordinate memory: the seed's striped ones, or the stream's single one. */
-  val memoryRows: Int = if (arch == Arch.Stream) capacity else depth
+  /** Whether a batch loads its next cell while the current one runs (see
+    * [[BatchControl]]). The stream's memory then holds two banks of
+    * `capacity` rows, one written while the other is read. The seed keeps
+    * one: its memories already cost 6m block RAMs, the budget that caps its m.
+    */
+  val overlapsLoads: Boolean = arch == Arch.Stream
+
+  /** Bits of an object index 0 .. capacity-1. */
+  val indexWidth: Int = log2Ceil(capacity).max(1)
+
+  /** Rows of each coordinate memory: the seed's striped ones, or the stream's
+    * single one, two banks of 2^indexWidth rows (a row is the bank bit over the index).
+    */
+  val memoryRows: Int = if (arch == Arch.Stream) 2 << indexWidth else depth
+
+  /** Whether a batch sends a cell of n boxes "head last": objects m+1 .. n-1
+    * first, into the memory while the last cell still runs, then objects
+    * 0 .. m, which enter the B window and the first A block straight from the
+    * load port once the last cell stopped issuing. Other cells (and single
+    * runs) are sent in index order.
+    */
+  def loadsHeadLast(n: Long): Boolean = overlapsLoads && n >= m + 2 && n <= capacity
+
+  /** The object index of the box sent at `position` in a batch's cell of n boxes. */
+  def batchLoadIndex(position: Int, n: Int): Int =
+    if (!loadsHeadLast(n)) position
+    else if (position < n - m - 1) m + 1 + position
+    else position - (n - m - 1)
 
   require(
     memoryStyle != MemoryStyle.Ecp5OutputRegister || memoryRows <= RegisteredReadMemory.maxEcp5Rows,
     s"memoryStyle ${MemoryStyle.Ecp5OutputRegister.name} builds each memory from DP16KD of at most " +
       s"${RegisteredReadMemory.maxEcp5Rows} rows (no cascade), got $memoryRows rows"
   )
-
-  /** Bits of an object index 0 .. capacity-1. */
-  val indexWidth: Int = log2Ceil(capacity).max(1)
 
   /** Bits of an object count 0 .. capacity. */
   val countWidth: Int = log2Ceil(capacity + 1)

@@ -7,25 +7,36 @@ import chisel3.util._
   *
   * The host pushes the box counts of a batch's cells on `cells` (a queue of
   * `batchCells` counts), then streams the boxes of all cells in order on the
-  * load port. For the cell at the head of the queue this module admits
-  * exactly its n boxes, then starts its run through run control, as a
-  * host's start(n) would (same checks, same errors, same engine), waits
-  * until that run has ended, pops the count and goes on with the next cell.
-  * The batch is over when a cell ends and no count is left.
+  * load port. The cell at the head of the queue is the one being loaded:
+  * this module admits exactly its n boxes, then starts its run through run
+  * control, as a host's start(n) would (same checks, same errors, same
+  * engine), once the cell before it has ended. The batch is over when a cell
+  * ends and no count is left.
   *
-  * Stage 1 does not overlap loading with computing: no box is admitted while
-  * a cell runs. Per cell the front end spends one cycle of its own, the one
-  * that ends the cell (pops its count); per batch one more, the cycle that
-  * accepts its first count (it empties the loader, like a start).
+  * Where the architecture overlaps loads ([[AccelParams.overlapsLoads]]),
+  * the head moves on to the next count as soon as its cell starts, so the
+  * next cell loads while the current one runs: its boxes past object m
+  * (sent first, [[AccelParams.loadsHeadLast]]) go to the memory's other
+  * bank at once; objects 0 .. m enter the B window from the load port, so
+  * they wait until the engine stops issuing (`engineActive` falls). Without
+  * overlap the head takes the next count only when its cell has ended, and
+  * no box is admitted while a cell runs.
+  *
+  * Per cell the front end spends one cycle of its own, the one that ends
+  * the cell; per batch one more, the cycle that accepts its first count (it
+  * empties the loader, like a start).
   */
 class BatchControl(p: AccelParams) extends Module {
   val io = IO(new Bundle {
     val cells      = Flipped(Decoupled(UInt(p.countWidth.W)))
     val hostStart  = Input(Bool()) // the host offers a single start: it wins over a batch's first count
     val runBusy    = Input(Bool()) // run control is running a run
+    val engineActive = Input(Bool()) // the engine is starting up or issuing: its B window is in use
+    val nextHead   = Input(Bool()) // the loader's next box is object 0 .. m
     val loadFire   = Input(Bool()) // a box was accepted
     val active     = Output(Bool()) // a batch is under way
     val begin      = Output(Bool()) // this cycle accepts a batch's first count
+    val take       = Valid(UInt(p.countWidth.W)) // the head takes this count: the loader starts the cell's numbering
     val loadReady  = Output(Bool()) // the current cell wants another box
     val start      = Valid(UInt(p.countWidth.W)) // start the current cell's run (run control is idle)
     val accumulate = Output(Bool()) // the start continues a batch: its counters add to the batch's
@@ -40,12 +51,13 @@ class BatchControl(p: AccelParams) extends Module {
   // the boxes admitted, cost stream m = 8 a third of its clock (114 -> 71 MHz).
   // The tail flows through when empty, so head + tail hold `batchCells`
   // counts and every count reaches the head in the cycle it would have
-  // reached the head of a single queue: the cycle count is unchanged.
-  val current   = Reg(UInt(p.countWidth.W)) // the current cell's count; valid while active
-  val left      = Reg(UInt(p.countWidth.W)) // boxes of the current cell still to admit
+  // reached the head of a single queue.
+  val current   = Reg(UInt(p.countWidth.W)) // the head cell's count; valid while `loading`
+  val left      = Reg(UInt(p.countWidth.W)) // boxes of the head cell still to admit
   val wantsBox  = RegInit(false.B) // loading, and left =/= 0: the registered load-ready
   val active    = RegInit(false.B)
-  val running   = RegInit(false.B) // the current cell's run was started
+  val loading   = RegInit(false.B) // the head holds a cell that has not started
+  val running   = RegInit(false.B) // a cell was started and has not ended
   val cellsDone = RegInit(0.U(32.W))
 
   // Outside a batch a count is taken only when no run is busy and no start is
@@ -65,9 +77,12 @@ class BatchControl(p: AccelParams) extends Module {
   assert(active || tailIn.ready, "the batch front end's tail queue held a count outside a batch")
   io.begin := io.cells.valid && !active && takesFirstCount
 
-  val loading = active && !running
-  io.loadReady   := wantsBox
-  io.start.valid := loading && !wantsBox
+  // Objects 0 .. m wait while the engine's window is in use (only a run of
+  // this batch can use it: a batch begins only when no run is busy).
+  val windowFree =
+    if (p.overlapsLoads && !p.has(Fault.HeadBoxesIgnoreWindow)) !io.nextHead || !io.engineActive else true.B
+  io.loadReady   := wantsBox && windowFree
+  io.start.valid := loading && !wantsBox && !running
   io.start.bits  := current
   // A register, not cellsDone =/= 0: a 32-bit test in front of every counter's enable was the next m = 8 critical path.
   val cellEnded = RegInit(false.B) // a cell of this batch has ended
@@ -76,24 +91,35 @@ class BatchControl(p: AccelParams) extends Module {
     left     := left - 1.U
     wantsBox := left =/= 1.U
   }
-  when(io.start.valid) { running := true.B }
 
   val cellEnd = active && running && !io.runBusy
-  // The head takes the next count when it is free: a batch's first, or the one after a cell that ends.
-  tail.ready := !active || cellEnd
+  // The head takes the next count when it is free: a batch's first; then,
+  // with overlap, when its cell starts (or later, if the count comes later),
+  // else when the running cell ends.
+  val headFree =
+    if (p.overlapsLoads && !p.has(Fault.BatchLoadsInSeries)) !loading || io.start.valid
+    else !loading && (!running || cellEnd)
+  tail.ready := !active || headFree
+  io.take.valid := tail.fire
+  io.take.bits  := tail.bits
+  when(io.start.valid) {
+    running := true.B
+    loading := false.B
+  }
   when(tail.fire) {
     current  := tail.bits
     left     := tail.bits
     wantsBox := tail.bits =/= 0.U
+    loading  := true.B
   }
   io.cellEnd := cellEnd
   // The deliberate bug of the batch mutant test: cells of fewer than two objects are not counted.
-  val counted = if (p.has(Fault.CellCounterSkipsShortCells)) current >= 2.U else true.B
+  val counted = if (p.has(Fault.CellCounterSkipsShortCells)) RegEnable(current >= 2.U, io.start.valid) else true.B
   when(cellEnd) {
     running   := false.B
     cellEnded := true.B
     when(counted) { cellsDone := cellsDone + 1.U }
-    when(!tail.valid) { active := false.B }
+    when(!loading && !tail.valid) { active := false.B }
   }
   when(io.begin) {
     active    := true.B

@@ -57,7 +57,8 @@ class AccelStatus(p: AccelParams) extends RunStatus(p) {
 
 /** Of the last run, or summed over the cells of the last batch (see docs/microarchitecture.md). */
 class AccelCounters(p: AccelParams) extends Bundle {
-  val loadCycles  = UInt(p.counterWidth.W) // first box loaded .. start accepted, both included (1 if no box)
+  val loadCycles  = UInt(p.counterWidth.W) // first box loaded .. start accepted, both included (1 if no box);
+                                           // in a batch: its cycles outside runs and cell ends
   val cycles      = UInt(p.counterWidth.W) // start accepted .. done
   val issueCycles = UInt(p.counterWidth.W) // cycles the comparator array was given work
   val stallCycles = UInt(p.counterWidth.W) // cycles the schedule waited on the result queue
@@ -89,12 +90,13 @@ class AccelInfo extends Bundle {
   val readLatency       = UInt(8.W) // stream: startup is max(m + 1 - n, readLatency) cycles
   val batchCells        = UInt(16.W) // cell counts the batch queue holds
   val cellTagWidth      = UInt(8.W)  // bits of a result beat's cell tag
+  val batchOverlapsLoads = Bool()    // a batch loads its next cell while one runs; cells are sent head last
 }
 
 /** The ports every architecture's engine offers the shared top level. */
 class EngineIO(p: AccelParams) extends Bundle {
   val write    = Flipped(Valid(new LoadWrite(p)))
-  val clear    = Input(Bool())                        // a start was accepted: the next box is object 0
+  val clear    = Input(Bool())                        // the loader restarts its numbering: a start, or a batch took a count
   val prepare  = Flipped(Valid(UInt(p.countWidth.W))) // a start was accepted (launched or not), with its n
   val launch   = Flipped(Valid(UInt(p.countWidth.W))) // a run of n >= 2 objects, all loaded
   val room     = Input(Bool())                        // the result queue has room for one more issue next cycle

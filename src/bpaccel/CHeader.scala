@@ -39,6 +39,7 @@ object CHeader {
       "DEBUG_PORT"          -> (if (p.debugPort) "1" else "0"),
       "BATCH_CELLS"         -> p.batchCells.toString,
       "CELL_TAG_WIDTH"      -> p.cellTagWidth.toString,
+      "BATCH_OVERLAPS_LOADS" -> (if (p.overlapsLoads) "1" else "0"),
       "FINGERPRINT"         -> s"\"${fingerprint(p)}\""
     ) ++ AccelError.names.map { case (name, e) => s"ERROR_$name" -> AccelError.code(e).toString }
     val body = defines.map { case (k, v) => s"#define BPACCEL_$k $v" }.mkString("\n")
@@ -63,13 +64,17 @@ object CHeader {
        | * cycles counts from the cycle after the start to done. A run keeps the
        | * device busy for load_cycles + cycles.
        | * Batches: push up to BPACCEL_BATCH_CELLS cell counts on `cells`, then
-       | * stream the boxes of all cells in order on `load`, with no start. Beats
-       | * carry `cell` (index in the batch mod 2^BPACCEL_CELL_TAG_WIDTH) and
-       | * indices local to their cell; done rises when the last cell ended.
-       | * Counters sum over the batch: load_cycles = 1 + sum(n_k + 1) and
-       | * cycles = sum(cycles_k + 1) for a host that pushes the first count, then
-       | * streams one box a cycle: one cycle per batch and one per cell belong
-       | * to the batch front end. */
+       | * stream the boxes of all cells in cell order on `load`, with no start.
+       | * With BPACCEL_BATCH_OVERLAPS_LOADS a cell of M + 2 <= n <= CAPACITY
+       | * boxes is sent head last: objects M+1 .. n-1, then 0 .. M; the device
+       | * loads it while the cell before runs. Other cells go in index order.
+       | * Beats carry `cell` (index in the batch mod 2^BPACCEL_CELL_TAG_WIDTH)
+       | * and indices local to their cell; done rises when the last cell ended.
+       | * Counters over a batch count each of its cycles once: cycles those of
+       | * its runs plus one per cell (the front end ends it), load_cycles every
+       | * other one from the cycle that takes the first count. Without overlap
+       | * and with a host that streams one box a cycle, load_cycles =
+       | * 1 + sum(n_k + 1) and cycles = sum(cycles_k + 1). */
        |
        |#endif /* BPACCEL_PARAMS_H */
        |""".stripMargin

@@ -34,6 +34,10 @@ object Fault {
   case object LookaheadIgnoresRoom extends Fault("the stream's look-ahead window enables ignore back-pressure")
   /** The batch front end does not count cells of fewer than two objects: later cells get the wrong tag. */
   case object CellCounterSkipsShortCells extends Fault("the batch's cell counter skips cells of 0 or 1 objects")
+  /** The batch front end takes the next count only when a cell ends, as before loads overlapped runs. */
+  case object BatchLoadsInSeries extends Fault("the batch loads its next cell only after the last one ended")
+  /** Objects 0 .. m of a batch's next cell are taken while the run before still uses the B window. */
+  case object HeadBoxesIgnoreWindow extends Fault("the next cell's objects 0 .. m enter the window while a run uses it")
 
   val all: Seq[Fault] = Seq(
     CreditOneTooMany,
@@ -47,6 +51,8 @@ object Fault {
     StrictCompare,
     WindowFillFromCount,
     LookaheadIgnoresRoom,
-    CellCounterSkipsShortCells
+    CellCounterSkipsShortCells,
+    BatchLoadsInSeries,
+    HeadBoxesIgnoreWindow
   )
 }

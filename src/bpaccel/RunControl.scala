@@ -21,14 +21,18 @@ class EngineActivity(p: AccelParams) extends Bundle {
   *
   * In a batch ([[BatchControl]]) the starts of its later cells `accumulate`:
   * the counters add up over the batch and the first error of the batch
-  * stays; a batch's `begin` restarts the load count, dropping boxes loaded
-  * without a start, and each `frontEndCycle` counts as device time.
+  * stays, and each `frontEndCycle` counts as device time. Loads may overlap
+  * runs there, so a batch counts its cycles once each: `cycles` those of its
+  * runs and its front end, `loadCycles` every other one from the `begin` on
+  * (loading that no run hides, and the starts). Their sum is the batch's
+  * time on the device.
   */
 class RunControl(p: AccelParams) extends Module {
   val io = IO(new Bundle {
     val start      = Flipped(Decoupled(UInt(p.countWidth.W)))
     val accumulate = Input(Bool()) // this start continues a batch
     val batchBegin = Input(Bool()) // a batch's first count is accepted: its load time starts
+    val batchActive = Input(Bool()) // a batch is under way
     val frontEndCycle = Input(Bool()) // a cycle the batch front end spends between cells
     val loadFire   = Input(Bool())
     val loaded     = Input(UInt(p.countWidth.W))
@@ -87,7 +91,7 @@ class RunControl(p: AccelParams) extends Module {
     busy            := runs
     done            := !runs
     io.launch.valid := runs
-    loadCycles        := Mux(io.accumulate, loadCycles + loadCyclesAtStart, loadCyclesAtStart)
+    when(!io.batchActive) { loadCycles := loadCyclesAtStart }
     loading           := false.B
     loadCyclesAtStart := 1.U // a start with nothing loaded costs its own cycle
     drainCycles     := 0.U
@@ -99,6 +103,13 @@ class RunControl(p: AccelParams) extends Module {
     }
   }
   when(io.frontEndCycle) { cycles := cycles + 1.U } // never while busy
+  // A batch's load time: one add a cycle, not the single run's span added at
+  // the start (two 64-bit adds in series were seed m = 8's critical path).
+  when(io.batchBegin) {
+    loadCycles := 1.U
+  }.elsewhen(io.batchActive && !busy && !io.frontEndCycle) {
+    loadCycles := loadCycles + 1.U
+  }
 
   when(busy) {
     cycles := cycles + 1.U

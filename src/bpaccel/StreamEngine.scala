@@ -52,13 +52,29 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val loadedBox = Wire(Valid(new LoadWrite(p)))
   loadedBox.valid := RegNext(io.write.valid, false.B)
   loadedBox.bits  := RegNext(io.write.bits)
+  // Objects 0 .. m enter the window from here; a batch's other boxes may
+  // arrive while a run reads the other bank, and only go to the memory.
+  val loadedHead = RegNext(io.write.valid && io.write.bits.head, false.B)
+
+  // ---- memory banks: a batch loads its next cell into one while a run reads the other ----
+  // Every accepted start turns the writes to the other bank; its run reads
+  // the bank its boxes went to. Each box carries the bank it was accepted for.
+  val writeBank  = RegInit(false.B)
+  val readBank   = RegInit(false.B)
+  val loadedBank = RegNext(writeBank)
+  when(io.prepare.valid) {
+    writeBank := !writeBank
+    readBank  := writeBank
+  }
+  private def row(bank: Bool, index: UInt): UInt = Cat(bank, index.pad(p.indexWidth))
 
   // ---- coordinate memory: one row of six keys per object (its read is below) ----
   // Top-level vals, so the memory keeps its plain name (module mem_<rows>x<width>).
-  val mem = Option.when(p.memoryStyle == MemoryStyle.Inferred)(SyncReadMem(p.capacity, UInt(W.W)))
-  for (mem <- mem) when(loadedBox.valid) { mem.write(loadedBox.bits.index, loadedBox.bits.box.asUInt) }
+  private val rows = p.memoryRows // two banks, so a row is the bank bit over the index
+  val mem = Option.when(p.memoryStyle == MemoryStyle.Inferred)(SyncReadMem(rows, UInt(W.W)))
+  for (mem <- mem) when(loadedBox.valid) { mem.write(row(loadedBank, loadedBox.bits.index), loadedBox.bits.box.asUInt) }
   val registeredMem =
-    Option.when(p.memoryStyle == MemoryStyle.Ecp5OutputRegister)(Module(new RegisteredReadMemory(p.capacity, W)))
+    Option.when(p.memoryStyle == MemoryStyle.Ecp5OutputRegister)(Module(new RegisteredReadMemory(rows, W)))
 
   // ---- run state ----
   val n        = Reg(UInt(p.countWidth.W))
@@ -122,12 +138,12 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       rHasNextBlock := rBlockLeft >= (2 * m).U
     } // past the last block the stream is never compared: hold
   }
-  // readsNeverMeetWrites: the memory is read only while a run is active and
-  // written only while none is (a run's first read comes two cycles after
-  // its last box was taken, its write one), so no read meets a write of its
-  // row, which lets the emitted memory drop the block RAM's collision bypass
+  // readsNeverMeetWrites: while a run reads its bank, boxes are written only
+  // to the other one (a run's first read comes two cycles after its last box
+  // was taken, its write one), so no read meets a write of its row, which
+  // lets the emitted memory drop the block RAM's collision bypass
   // (NoCollisionMemories).
-  assert(!(loadedBox.valid && readEvent), "a box was written while the stream read the memory")
+  assert(!(loadedBox.valid && readEvent && loadedBank === readBank), "a box was written to the bank the stream reads")
   // ---- the memory's read ----
   val read = Wire(Valid(new Entry))
   read.valid    := RegNext(readEvent, false.B)
@@ -135,14 +151,14 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // The read, then memoryOutputStages registers; the first may sit in the block RAM.
   val readStages = (mem, registeredMem) match {
     case (Some(mem), _) =>
-      read.bits.box := mem.read(rObj, readEvent)
+      read.bits.box := mem.read(row(readBank, rObj), readEvent)
       Seq.iterate(read, p.memoryOutputStages + 1)(x => Pipe(x))
     case (_, Some(mem)) =>
       mem.io.writeEnable := loadedBox.valid
-      mem.io.writeRow    := loadedBox.bits.index
+      mem.io.writeRow    := row(loadedBank, loadedBox.bits.index)
       mem.io.writeData   := loadedBox.bits.box.asUInt
       mem.io.readEnable  := readEvent
-      mem.io.readRow     := rObj
+      mem.io.readRow     := row(readBank, rObj)
       read.bits.box := DontCare // only inside the memory
       val first = Wire(Valid(new Entry))
       first.valid    := RegNext(read.valid, false.B)
@@ -182,7 +198,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val owesAll    = ((BigInt(1) << (m + 1)) - 1).U((m + 1).W) // m+1 shifts owed: a start
   val owes       = RegInit(owesAll)
   val takesLoads = owes(0)
-  val loadShift  = loadedBox.valid && takesLoads
+  val loadShift  = loadedHead && takesLoads
   val owesAfterShift = Mux(loadShift, owes >> 1, owes) // at most m+1 boxes shift in
   val owesNext       = Mux(io.clear, owesAll, owesAfterShift)
   owes := owesNext
@@ -208,11 +224,13 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val fillingSoon  = Mux(io.prepare.valid, launchFills, fillingCarry)
   val unlaunchedStart = RegNext(io.prepare.valid && !io.launch.valid, false.B)
   val entry = Wire(new Entry)
-  entry.box := Mux(loadedBox.valid, loadedBox.bits.box.asUInt, readQueue.io.deq.bits.box)
-  entry.tag := Mux(loadedBox.valid, tagOf(loadedBox.bits.index), readQueue.io.deq.bits.tag)
+  entry.box := Mux(loadedHead, loadedBox.bits.box.asUInt, readQueue.io.deq.bits.box)
+  entry.tag := Mux(loadedHead, tagOf(loadedBox.bits.index), readQueue.io.deq.bits.tag)
+  // Objects 0 .. m come only while the window is free: the batch front end holds them back.
+  assert(!(loadedHead && (starting || issuing)), "a box entered the window while a run used it")
   val windowShift = replicatedEnable(
     "windowShift",
-    next = (io.write.valid && takesLoadsNext) || fillingSoon ||
+    next = (io.write.valid && io.write.bits.head && takesLoadsNext) || fillingSoon ||
       (issuingNext && (io.room || p.has(Fault.LookaheadIgnoresRoom).B)),
     now = loadShift || filling || issue
   )

@@ -33,7 +33,9 @@ class AccelParamsSpec extends AnyFlatSpec with Matchers {
     val outreg = MemoryStyle.Ecp5OutputRegister
     rejection(AccelParams(memoryOutputStages = 0, memoryStyle = outreg)) should include("memoryOutputStages >= 1")
     rejection(AccelParams(m = 1, capacity = 4096, memoryStyle = outreg)) should include("4096 rows")
-    rejection(AccelParams(m = 2, capacity = 4096, arch = Arch.Stream, memoryStyle = outreg)) should include("4096 rows")
+    // The stream's memory holds two banks of the capacity.
+    rejection(AccelParams(m = 2, capacity = 2048, arch = Arch.Stream, memoryStyle = outreg)) should include("4096 rows")
+    AccelParams(m = 2, capacity = 1024, arch = Arch.Stream, memoryStyle = outreg).memoryRows shouldBe 2048
     AccelParams(m = 2, capacity = 4096, memoryStyle = outreg).memoryRows shouldBe 2048 // seed: rows per lane
     MemoryStyle.fromName("ecp5-outreg") shouldBe outreg
     intercept[IllegalArgumentException](MemoryStyle.fromName("outreg")).getMessage should include("inferred, ecp5-outreg")

@@ -160,12 +160,12 @@ class VerilogEmissionSpec extends AnyFlatSpec with Matchers {
       lint(emitted(m, Arch.Stream, capacity = Some(1000))._2)
     }
 
-  it should "give the stream architecture one memory of six keys a row, whatever m" in {
+  it should "give the stream architecture one memory of six keys a row, two banks of the capacity, whatever m" in {
     for (m <- Seq(2, 16)) withClue(s"m=$m: ") {
       val (p, dir) = emitted(m, Arch.Stream, capacity = Some(2048))
       val memories = svFiles(dir).filter(_.startsWith("mem_"))
-      memories shouldBe Seq(s"mem_2048x${6 * p.keyWidth}.sv")
-      read(dir, memories.head) should include(s"reg [${6 * p.keyWidth - 1}:0] Memory[0:2047];")
+      memories shouldBe Seq(s"mem_4096x${6 * p.keyWidth}.sv")
+      read(dir, memories.head) should include(s"reg [${6 * p.keyWidth - 1}:0] Memory[0:4095];")
       read(dir, "bpaccel_params.h") should include("#define BPACCEL_ARCH \"stream\"\n")
       svFiles(dir) should not contain "Rotator.sv"
     }
