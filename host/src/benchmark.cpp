@@ -483,7 +483,7 @@ std::string Benchmark::table(const nlohmann::json& results) {
     legend = fmt::format(
         "accelerator = measured host + modelled device ({:.1f} MHz, device cycles with loads, {} backend) + modelled "
         "transfer ({:.1f} GB/s, {:.1f} us per hand-over of up to {} cells; boxes stream through the "
-        "24-byte-a-cycle load port, so only the link's excess over the load cycles counts)",
+        "24-byte-a-cycle load port, so only the link's excess over one cycle a box counts)",
         cfg["clock_hz"].get<double>() / 1e6, cfg["accelerator_backend"].get<std::string>(),
         cfg["link_model"]["bandwidth_bytes_per_second"].get<double>() / 1e9,
         cfg["link_model"]["latency_seconds_per_run"].get<double>() * 1e6,
