@@ -38,7 +38,7 @@ struct LineUpConfig {
   std::vector<std::optional<std::size_t>> cellSizes{std::nullopt, 16, 32, 64, 128, 256};
   /// Cell sizes of the extra "accelerator grid C" and "cpu grid C" rows (the
   /// uniform grid partition instead of the k-d tree); empty: none.
-  std::vector<std::size_t> gridCellSizes{128, 256};
+  std::vector<std::size_t> gridCellSizes{64, 128, 256};
   /// Methods that test all n(n-1)/2 pairs a frame are skipped above this.
   double maxAllPairsTests = 1e8;
   /// A sweep along x that cannot be stopped midway (FCL's SaP, rebuilt every
