@@ -36,7 +36,7 @@ class BatchControl(p: AccelParams) extends Module {
     val loadFire   = Input(Bool()) // a box was accepted
     val active     = Output(Bool()) // a batch is under way
     val begin      = Output(Bool()) // this cycle accepts a batch's first count
-    val take       = Valid(UInt(p.countWidth.W)) // the head takes this count: the loader starts the cell's numbering
+    val take       = Valid(new CellCount(p)) // the head takes this count: the loader starts the cell's numbering
     val loadReady  = Output(Bool()) // the current cell wants another box
     val start      = Valid(UInt(p.countWidth.W)) // start the current cell's run (run control is idle)
     val accumulate = Output(Bool()) // the start continues a batch: its counters add to the batch's
@@ -65,9 +65,9 @@ class BatchControl(p: AccelParams) extends Module {
   // taken while it is in use.
   val takesFirstCount = !io.runBusy && !io.hostStart
   val takesCount = (active && (p.batchCells > 1).B) || takesFirstCount
-  val tailIn     = Wire(Decoupled(UInt(p.countWidth.W)))
+  val tailIn     = Wire(Decoupled(new CellCount(p)))
   tailIn.valid   := io.cells.valid && takesCount
-  tailIn.bits    := io.cells.bits
+  tailIn.bits    := CellCount(p, io.cells.bits)
   io.cells.ready := tailIn.ready && takesCount
   val tail = Queue(tailIn, p.batchCells - 1, flow = true) // no entries: a wire
   // Outside a batch the tail is empty and a count flows straight to the head,
@@ -107,9 +107,9 @@ class BatchControl(p: AccelParams) extends Module {
     loading := false.B
   }
   when(tail.fire) {
-    current  := tail.bits
-    left     := tail.bits
-    wantsBox := tail.bits =/= 0.U
+    current  := tail.bits.count
+    left     := tail.bits.count
+    wantsBox := tail.bits.count =/= 0.U
     loading  := true.B
   }
   io.cellEnd := cellEnd

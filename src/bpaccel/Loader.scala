@@ -18,6 +18,33 @@ class LoadWrite(p: AccelParams) extends Bundle {
   val head = Bool()
 }
 
+/** A batch cell's box count, with the loader's numbering for it decided as
+  * the count is queued: deciding it from the queue's output put the queue's
+  * LUT RAM and two count compares in front of the loader's index (stream
+  * m = 32's critical path, 91.3 MHz). Only where loads overlap runs do the
+  * last two fields have bits.
+  */
+class CellCount(p: AccelParams) extends Bundle {
+  val count     = UInt(p.countWidth.W)
+  val headLast  = UInt((if (p.overlapsLoads) 1 else 0).W) // p.loadsHeadLast(count)
+  val lastIndex = UInt((if (p.overlapsLoads) p.indexWidth else 0).W) // count - 1, when head last
+}
+
+object CellCount {
+  def apply(p: AccelParams, count: UInt): CellCount = {
+    val c = Wire(new CellCount(p))
+    c.count := count
+    if (p.overlapsLoads) {
+      c.headLast  := (count >= (p.m + 2).U && count <= p.capacity.U).asUInt
+      c.lastIndex := (count - 1.U)(p.indexWidth - 1, 0)
+    } else {
+      c.headLast  := 0.U
+      c.lastIndex := 0.U
+    }
+    c
+  }
+}
+
 /** Numbers the boxes of a run and refuses (with `overflow`) any box beyond
   * the capacity. A clear makes the next box object 0, or, when `headLast`
   * gives the count of a batch's cell that is sent head last
@@ -29,7 +56,7 @@ class Loader(p: AccelParams) extends Module {
     val load     = Flipped(Valid(new Aabb(p.keyWidth))) // an accepted box
     val clear    = Input(Bool())
     // With clear: the next cell's count, when it may be sent head last (only where loads overlap runs).
-    val headLast = Option.when(p.overlapsLoads)(Flipped(Valid(UInt(p.countWidth.W))))
+    val headLast = Option.when(p.overlapsLoads)(Flipped(Valid(new CellCount(p))))
     val write    = Valid(new LoadWrite(p))
     val loaded   = Output(UInt(p.countWidth.W))
     val overflow = Output(Bool()) // a box arrived when `capacity` were loaded; held until clear
@@ -95,7 +122,7 @@ class Loader(p: AccelParams) extends Module {
     }
   }
   when(io.clear) {
-    val headLastCell = io.headLast.map(h => h.valid && h.bits >= (m + 2).U && h.bits <= p.capacity.U).getOrElse(false.B)
+    val headLastCell = io.headLast.map(h => h.valid && h.bits.headLast.asBool).getOrElse(false.B)
     loaded   := 0.U
     lane     := 0.U
     row      := 0.U
@@ -103,7 +130,7 @@ class Loader(p: AccelParams) extends Module {
     full     := false.B
     wraps    := headLastCell
     inOrder  := !headLastCell
-    for (h <- io.headLast) lastIndex := h.bits - 1.U
+    for (h <- io.headLast) lastIndex := h.bits.lastIndex
     index          := Mux(headLastCell, (m + 1).U, 0.U)
     head           := !headLastCell
     firstBlockLane := Mux(headLastCell, 0.U, 1.U)
