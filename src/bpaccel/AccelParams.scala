@@ -154,9 +154,10 @@ case class AccelParams(
   val laneWidth: Int = log2Ceil(m).max(1)
 
   /** Read events from a memory address to its data at the stream's window
-    * entry: the memory's own read plus the output registers.
+    * entry: the memory's own read, the output registers and the read queue's
+    * head register.
     */
-  val readLatency: Int = 1 + memoryOutputStages
+  val readLatency: Int = 1 + memoryOutputStages + 1
 
   /** Cycles from an issue to its hit mask at the result queue. Seed: memory
     * read, memory output registers, rotator register, comparator register, AND

@@ -109,7 +109,7 @@ class BatchControl(p: AccelParams) extends Module {
   when(tail.fire) {
     current  := tail.bits.count
     left     := tail.bits.count
-    wantsBox := tail.bits.count =/= 0.U
+    wantsBox := tail.bits.nonEmpty
     loading  := true.B
   }
   io.cellEnd := cellEnd

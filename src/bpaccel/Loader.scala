@@ -26,6 +26,7 @@ class LoadWrite(p: AccelParams) extends Bundle {
   */
 class CellCount(p: AccelParams) extends Bundle {
   val count     = UInt(p.countWidth.W)
+  val nonEmpty  = Bool() // count =/= 0: the OR tree behind the queue's LUT RAM was the next path (84.7 MHz)
   val headLast  = UInt((if (p.overlapsLoads) 1 else 0).W) // p.loadsHeadLast(count)
   val lastIndex = UInt((if (p.overlapsLoads) p.indexWidth else 0).W) // count - 1, when head last
 }
@@ -33,7 +34,8 @@ class CellCount(p: AccelParams) extends Bundle {
 object CellCount {
   def apply(p: AccelParams, count: UInt): CellCount = {
     val c = Wire(new CellCount(p))
-    c.count := count
+    c.count    := count
+    c.nonEmpty := count =/= 0.U
     if (p.overlapsLoads) {
       c.headLast  := (count >= (p.m + 2).U && count <= p.capacity.U).asUInt
       c.lastIndex := (count - 1.U)(p.indexWidth - 1, 0)

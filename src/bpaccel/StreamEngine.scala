@@ -102,11 +102,16 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // The memory and its output registers run freely (no enable, no
   // multiplexer after the block RAM); reads are issued while the queue has
   // room for them, and each issue takes one entry. Reading starts with the
-  // run, so the first object reaches the queue readLatency cycles later, and
-  // the reader then stays ahead: an issue always finds its object there.
+  // run, so the first object reaches the queue's head register readLatency
+  // cycles later, and the reader then stays ahead: an issue always finds its
+  // object there. The head register feeds the window's entry: the queue's
+  // LUT RAM, read behind its pointer, fed lane m-1 directly (stream m = 32's
+  // critical path, 100.8 MHz, 8.4 ns of wire).
   val readQueue = Module(
-    new Queue(new Entry, p.readLatency + 2, flow = true, hasFlush = true)
+    new Queue(new Entry, p.readLatency + 1, flow = true, hasFlush = true)
   )
+  val readHead = Module(new Queue(new Entry, 1, pipe = true, hasFlush = true))
+  readHead.io.enq <> readQueue.io.deq
   val readsInFlight = Wire(UInt(log2Ceil(p.readLatency + 1).W))
   // Queue slots not yet taken or claimed by a read in flight, kept as a
   // register: comparing the queue's count plus the reads in flight with its
@@ -170,16 +175,17 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   readsInFlight := PopCount(readStages.map(_.valid))
   readQueue.io.enq.valid := readStages.last.valid
   readQueue.io.enq.bits  := readStages.last.bits
-  readQueue.io.deq.ready := issue
+  readHead.io.deq.ready  := issue
   readQueue.io.flush.get := io.launch.valid // drop what the last run read ahead
-  assert(!issue || readQueue.io.deq.valid, "the stream's reader fell behind the schedule")
+  readHead.io.flush.get  := io.launch.valid
+  assert(!issue || readHead.io.deq.valid, "the stream's reader fell behind the schedule")
   assert(!readQueue.io.enq.valid || readQueue.io.enq.ready, "the stream's read queue overflowed")
   // A run is launched only after its boxes were loaded, at least two cycles
   // after the last run's last read left its pipeline, so the flush drops
   // every read of that run and all credits come back.
   assert(!io.launch.valid || readsInFlight === 0.U, "a read of the last run was in flight at a launch")
   assert(
-    readQueue.io.count +& readsInFlight +& readCredits === readDepth.U || io.launch.valid,
+    readQueue.io.count +& readHead.io.count +& readsInFlight +& readCredits === readDepth.U || io.launch.valid,
     "the stream's read credits do not match the queue"
   )
 
@@ -224,8 +230,8 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val fillingSoon  = Mux(io.prepare.valid, launchFills, fillingCarry)
   val unlaunchedStart = RegNext(io.prepare.valid && !io.launch.valid, false.B)
   val entry = Wire(new Entry)
-  entry.box := Mux(loadedHead, loadedBox.bits.box.asUInt, readQueue.io.deq.bits.box)
-  entry.tag := Mux(loadedHead, tagOf(loadedBox.bits.index), readQueue.io.deq.bits.tag)
+  entry.box := Mux(loadedHead, loadedBox.bits.box.asUInt, readHead.io.deq.bits.box)
+  entry.tag := Mux(loadedHead, tagOf(loadedBox.bits.index), readHead.io.deq.bits.tag)
   // Objects 0 .. m come only while the window is free: the batch front end holds them back.
   assert(!(loadedHead && (starting || issuing)), "a box entered the window while a run used it")
   val windowShift = replicatedEnable(

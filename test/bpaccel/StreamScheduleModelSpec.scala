@@ -17,7 +17,7 @@ class StreamScheduleModelSpec extends AnyFlatSpec with Matchers {
     val random = Seq.fill(40)((1 + rng.nextInt(40), rng.nextInt(400)))
     small ++ larger ++ random
   }
-  private val latencies = Seq(1, 3)
+  private val latencies = Seq(2, 4) // memoryOutputStages 0 and 2, plus the memory's read and the read queue's head
 
   "The stream schedule" should "test every pair i < j exactly once and nothing else" in {
     for ((m, n) <- cases; l <- latencies) withClue(s"m=$m n=$n readLatency=$l: ") {
@@ -42,7 +42,7 @@ class StreamScheduleModelSpec extends AnyFlatSpec with Matchers {
 
   it should "start up in max(m + 1 - n, readLatency) cycles, the closed form" in {
     for ((m, n) <- cases if n >= 2; l <- latencies) withClue(s"m=$m n=$n readLatency=$l: ") {
-      val p = AccelParams(m = m, capacity = 1024, memoryOutputStages = l - 1, arch = Arch.Stream)
+      val p = AccelParams(m = m, capacity = 1024, memoryOutputStages = l - 2, arch = Arch.Stream)
       StreamScheduleModel.run(n, m, l).startupCycles.toLong shouldBe p.startupCycles(n)
     }
   }
