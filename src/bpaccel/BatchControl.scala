@@ -70,6 +70,15 @@ class BatchControl(p: AccelParams) extends Module {
   tailIn.bits    := CellCount(p, io.cells.bits)
   io.cells.ready := tailIn.ready && takesCount
   val tail = Queue(tailIn, p.batchCells - 1, flow = true) // no entries: a wire
+  // Whether the tail offers a count, from a register (the queue held one at
+  // the cycle's start) or the count flowing through: the queue's own valid
+  // compares its pointers, and with overlapped loads every count taken
+  // clears the loader and the engine's owed shifts (stream m = 32's
+  // critical path at 597e8e6, 100.2 MHz: tail pointers -> take -> clear).
+  val tailHolds = RegInit(false.B)
+  val tailValid = tailHolds || tailIn.valid
+  assert(tailValid === tail.valid, "the tail queue's registered non-empty flag is wrong")
+  val tailFire = tailValid && tail.ready
   // Outside a batch the tail is empty and a count flows straight to the head,
   // so the first count is taken without asking the tail queue: its pointers
   // were the start of stream m = 64's critical path (through `begin` and the
@@ -100,13 +109,21 @@ class BatchControl(p: AccelParams) extends Module {
     if (p.overlapsLoads && !p.has(Fault.BatchLoadsInSeries)) !loading || io.start.valid
     else !loading && (!running || cellEnd)
   tail.ready := !active || headFree
-  io.take.valid := tail.fire
+  io.take.valid := tailFire
+  // Counts held in the tail queue, kept beside it: an arriving count is
+  // stored unless it flows straight to the head (queue empty, taken at once).
+  val tailCount = RegInit(0.U(log2Ceil(p.batchCells).W))
+  val stored    = tailIn.fire && !(tailFire && !tailHolds)
+  val unstored  = tailFire && tailHolds
+  val tailCountNext = tailCount + stored.asUInt - unstored.asUInt
+  tailCount := tailCountNext
+  tailHolds := tailCountNext =/= 0.U
   io.take.bits  := tail.bits
   when(io.start.valid) {
     running := true.B
     loading := false.B
   }
-  when(tail.fire) {
+  when(tailFire) {
     current  := tail.bits.count
     left     := tail.bits.count
     wantsBox := tail.bits.nonEmpty
@@ -119,7 +136,7 @@ class BatchControl(p: AccelParams) extends Module {
     running   := false.B
     cellEnded := true.B
     when(counted) { cellsDone := cellsDone + 1.U }
-    when(!loading && !tail.valid) { active := false.B }
+    when(!loading && !tailValid) { active := false.B }
   }
   when(io.begin) {
     active    := true.B
