@@ -110,6 +110,7 @@ class BatchControl(p: AccelParams) extends Module {
     else !loading && (!running || cellEnd)
   tail.ready := !active || headFree
   io.take.valid := tailFire
+  io.take.bits  := tail.bits
   // Counts held in the tail queue, kept beside it: an arriving count is
   // stored unless it flows straight to the head (queue empty, taken at once).
   val tailCount = RegInit(0.U(log2Ceil(p.batchCells).W))
@@ -118,7 +119,6 @@ class BatchControl(p: AccelParams) extends Module {
   val tailCountNext = tailCount + stored.asUInt - unstored.asUInt
   tailCount := tailCountNext
   tailHolds := tailCountNext =/= 0.U
-  io.take.bits  := tail.bits
   when(io.start.valid) {
     running := true.B
     loading := false.B
