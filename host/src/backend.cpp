@@ -44,6 +44,8 @@ ModelBackend::ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t ru
 
 void ModelBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) {
   runCell(boxes, out, stats);
+  stats.loadCycles += boxes.size() + 1;  // one box a cycle, then the start cycle
+  stats.cycles += busyCycles(boxes.size());
   stats.runs += 1;
   stats.batches += 1;
 }
@@ -55,16 +57,12 @@ void ModelBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std:
       throw std::length_error(fmt::format("model: a cell of {} boxes exceeds the capacity {}", cell.size(), capacity_));
   for (std::size_t first = 0; first < cells.size(); first += batchCells_) {
     const auto batch = cells.subspan(first, std::min(batchCells_, cells.size() - first));
-    RunStats cells;
     for (const auto& cell : batch) {
-      runCell(cell, out, cells);
+      runCell(cell, out, stats);
       cellEnds.push_back(out.size());
     }
     // The cycles come from the batch's timeline, not from its cells one by one.
-    cells.loadCycles = 0;
-    cells.cycles = 0;
-    batchCycles(batch, cells);
-    stats += cells;
+    batchCycles(batch, stats);
     stats.runs += batch.size();
     stats.batches += 1;
   }
@@ -90,9 +88,7 @@ void ModelBackend::runCell(std::span<const KeyBox> boxes, std::vector<Pair>& out
       beats += hit;
     }
   }
-  stats.loadCycles += n + 1;  // one box a cycle, then the start cycle
   stats.issueCycles += scheduleIssueCycles(n, m_);
-  stats.cycles += busyCycles(n);
   stats.hits += out.size() - before;
   stats.boxesSent += n;
   stats.beatsReceived += beats;

@@ -70,7 +70,8 @@ class ModelBackend final : public Backend {
                 std::vector<std::size_t>& cellEnds, RunStats& stats) override;
 
  private:
-  /// One cell's pairs and counters, without counting it as a run.
+  /// One cell's pairs and counters, without counting it as a run; its load
+  /// cycles and cycles depend on the hand-over (run, or batchCycles).
   void runCell(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) const;
   /// Cycles before a run of n objects issues (0 for the seed), and all its busy cycles.
   std::uint64_t startupCycles(std::uint64_t n) const;

@@ -67,7 +67,7 @@ class RunControl(p: AccelParams) extends Module {
 
   io.start.ready := !busy
 
-  when(io.batchBegin || (io.loadFire && !loading)) {
+  when(io.loadFire && !loading) {
     loading           := true.B
     loadCyclesAtStart := 2.U // this cycle and a start in the next
   }.elsewhen(loading) {

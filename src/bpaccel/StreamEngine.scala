@@ -54,7 +54,8 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   loadedBox.bits  := RegNext(io.write.bits)
   // Objects 0 .. m enter the window from here; a batch's other boxes may
   // arrive while a run reads the other bank, and only go to the memory.
-  val loadedHead = RegNext(io.write.valid && io.write.bits.head, false.B)
+  val headWrite  = io.write.valid && io.write.bits.head
+  val loadedHead = RegNext(headWrite, false.B)
 
   // ---- memory banks: a batch loads its next cell into one while a run reads the other ----
   // Every accepted start turns the writes to the other bank; its run reads
@@ -77,7 +78,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     Option.when(p.memoryStyle == MemoryStyle.Ecp5OutputRegister)(Module(new RegisteredReadMemory(rows, W)))
 
   // ---- run state ----
-  val n        = Reg(UInt(p.countWidth.W))
   val starting = RegInit(false.B)
   val issuing  = RegInit(false.B)
   // Window shifts still needed at startup, as a thermometer like `owes`
@@ -236,7 +236,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   assert(!(loadedHead && (starting || issuing)), "a box entered the window while a run used it")
   val windowShift = replicatedEnable(
     "windowShift",
-    next = (io.write.valid && io.write.bits.head && takesLoadsNext) || fillingSoon ||
+    next = (headWrite && takesLoadsNext) || fillingSoon ||
       (issuingNext && (io.room || p.has(Fault.LookaheadIgnoresRoom).B)),
     now = loadShift || filling || issue
   )
@@ -344,7 +344,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   assert(!io.launch.valid || (io.prepare.valid && io.prepare.bits === io.launch.bits), "a launch without its start")
   when(io.prepare.valid) {
     val count = io.prepare.bits // >= 2 when it launches
-    n         := count
     primeLeft := p.readLatency.U
     // The last box may shift in during this cycle.
     fillMoreThan1 := (if (p.has(Fault.WindowFillFromCount)) VecInit((0 until m).map(k => count < (m - k).U)).asUInt // m+1-count > k+1
