@@ -121,9 +121,10 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   if (p.has(Fault.DropBeatWhenNotReady)) queue.io.deq.ready := true.B
 
   // The popcount gets its own register: at m = 32 popcount + 64-bit add was
-  // the critical path (80.7 MHz). The count still lands by the time done
-  // rises, which is at least one cycle after the last beat was queued.
-  control.io.queuedHits := Pipe(queue.io.enq.fire, PopCount(beat.bits.mask))
+  // the critical path (80.7 MHz). The engine counts groups of lanes beside
+  // the mask, so only their sum is left here. The count still lands by the
+  // time done rises, which is at least one cycle after the last beat was queued.
+  control.io.queuedHits := Pipe(queue.io.enq.fire, Engine.sumHitCounts(p.m, engine.io.outHitCounts))
   control.io.queueEmpty       := queue.io.count === 0.U
 
   io.status.error     := control.io.status.error

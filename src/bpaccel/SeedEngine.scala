@@ -133,7 +133,7 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   compare.io.b := rotatedB
   val compared   = RegNext(compare.io.compares)
   val atCompared = Pipe(atRotated)
-  val (hitMask, anyHit) = hitRegisters(ComparatorArray.hits(compared) & atCompared.bits.laneMask)
+  val hits = hitRegisters(ComparatorArray.hits(compared) & atCompared.bits.laneMask)
   val atAnd  = Pipe(atCompared)
   val probeI = RegNext(RegNext(aBlockTag))
 
@@ -146,5 +146,5 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   io.activity.inFlight := PopCount(stages.map(_.valid))
   io.activity.retired  := stages.last.valid
 
-  emit(atAnd.valid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, probeI, atAnd.bits.probeJ, hitMask, anyHit)
+  emit(atAnd.valid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, probeI, atAnd.bits.probeJ, hits)
 }

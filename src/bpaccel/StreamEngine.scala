@@ -401,7 +401,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   compare.io.b := VecInit(window.map(boxOf))
   val compared = RegNext(compare.io.compares)
   val atCompare = Pipe(issue, meta)
-  val (hitMask, anyHit) = hitRegisters(ComparatorArray.hits(compared) & atCompare.bits.laneMask)
+  val hits = hitRegisters(ComparatorArray.hits(compared) & atCompare.bits.laneMask)
   val atAnd     = Pipe(atCompare)
   require(p.pipelineLatency == 2)
 
@@ -430,5 +430,5 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   val outValid =
     if (p.has(Fault.RepeatLastBeat)) atAnd.valid || (RegNext(atAnd.valid, false.B) && !atAnd.valid) else atAnd.valid
-  emit(outValid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, atAnd.bits.probeI, atAnd.bits.probeJ, hitMask, anyHit)
+  emit(outValid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, atAnd.bits.probeI, atAnd.bits.probeJ, hits)
 }

@@ -24,7 +24,7 @@ class ResultSpec extends AnyFlatSpec with Simulators with Checks {
 
   for (
     (m, capacity, arch) <- Seq((1, 16), (2, 16), (3, 24), (4, 32), (5, 40), (8, 64)).map { case (m, c) => (m, c, Arch.Seed) } ++
-                             Seq((1, 16, Arch.Stream), (3, 25, Arch.Stream), (8, 64, Arch.Stream))
+                             Seq((1, 16, Arch.Stream), (3, 25, Arch.Stream), (8, 64, Arch.Stream), (12, 48, Arch.Stream)) // 12: two hit-count groups, one short
   )
     it should s"report exactly the brute-force pairs under any back-pressure (m=$m, ${arch.name})" in {
       val p = AccelParams(m = m, capacity = capacity, arch = arch)
