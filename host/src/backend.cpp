@@ -12,14 +12,6 @@ std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m) {
   return blocks * (n - 1) - m * blocks * (blocks - 1) / 2;
 }
 
-std::size_t batchLoadIndex(std::size_t position, std::size_t n, std::size_t m, std::size_t capacity,
-                           bool overlapsLoads) {
-  const bool headLast = overlapsLoads && n >= m + 2 && n <= capacity;
-  if (!headLast) return position;
-  const std::size_t tail = n - m - 1;  // objects m+1 .. n-1, sent first
-  return position < tail ? m + 1 + position : position - tail;
-}
-
 void Backend::runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
                        std::vector<std::size_t>& cellEnds, RunStats& stats) {
   for (const auto& cell : cells) {
@@ -95,10 +87,10 @@ void ModelBackend::runCell(std::span<const KeyBox> boxes, std::vector<Pair>& out
 }
 
 std::uint64_t ModelBackend::startupCycles(std::uint64_t n) const {
-  // Stream: the window must hold objects 1..m (n <= m: m+1-n shifts after the
-  // load) while the first reads reach its entry.
-  if (n < 2 || streamReadLatency_ == 0) return 0;
-  return std::max<std::uint64_t>(m_ + 1 > n ? m_ + 1 - n : 0, streamReadLatency_);
+  // Stream: the first reads reach the window's entry while the start's copy
+  // of objects 0 .. m fills the window and the A block.
+  if (n < 2) return 0;
+  return streamReadLatency_;
 }
 
 std::uint64_t ModelBackend::busyCycles(std::uint64_t n) const {
@@ -109,23 +101,14 @@ void ModelBackend::batchCycles(std::span<const std::span<const KeyBox>> batch, R
   // Cycle 0 takes the first count; every count and box is offered as soon as
   // the device can take it, and the consumer never stalls.
   std::uint64_t countTaken = 0;   // the cycle the device takes the cell's count
-  std::uint64_t windowFree = 0;   // first cycle objects 0..m may enter (the last run stopped issuing)
   std::uint64_t nextStart = 0;    // earliest start: the cycle after the last cell ended
   std::uint64_t end = 0, run = 0;
   for (const auto& cell : batch) {
     const std::uint64_t n = cell.size();
-    std::uint64_t lastBox = countTaken;
-    for (std::uint64_t position = 0; position < n; ++position) {
-      // A box past the capacity is refused and numbers nothing, so it counts as the last one taken.
-      const std::uint64_t object = std::min<std::uint64_t>(
-          batchLoadIndex(position, n, m_, capacity_, overlapsLoads_), capacity_);
-      const bool entersWindow = overlapsLoads_ && object <= m_;
-      lastBox = std::max(lastBox + 1, entersWindow ? windowFree : 0);
-    }
+    const std::uint64_t lastBox = countTaken + n;  // one box a cycle after the count
     const std::uint64_t start = std::max(lastBox + 1, nextStart);
     const bool launched = n >= 2 && n <= capacity_;
     const std::uint64_t busy = launched ? busyCycles(n) : 0;
-    if (launched) windowFree = start + startupCycles(n) + scheduleIssueCycles(n, m_) + 1;
     end = start + busy + 1;  // the front end's own cycle ends the cell
     run += busy + 1;
     nextStart = end + 1;

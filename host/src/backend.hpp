@@ -33,15 +33,6 @@ class Backend {
                         std::vector<std::size_t>& cellEnds, RunStats& stats);
 };
 
-/// Which object of a batch's cell of n boxes the device takes at `position`.
-/// Where loads overlap runs (BPACCEL_BATCH_OVERLAPS_LOADS) a cell of
-/// m + 2 <= n <= capacity boxes is sent head last: objects m+1 .. n-1 go into
-/// the memory while the cell before still runs, then objects 0 .. m, which
-/// enter the device's B window. Every other cell, and every single run, is
-/// sent in index order. Must equal bpaccel.AccelParams.batchLoadIndex.
-std::size_t batchLoadIndex(std::size_t position, std::size_t n, std::size_t m, std::size_t capacity,
-                           bool overlapsLoads);
-
 /// The accelerator's schedule in closed form: issue cycles of one run of n
 /// objects with m lanes, sum over blocks b of (n - 1 - b*m); 0 for n < 2.
 /// Must equal bpaccel.Schedule.issueCycles in the generator (tests compare
@@ -53,7 +44,7 @@ std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m);
 /// cycle and a consumer that never stalls, for any n up to its capacity and
 /// at software speed. Both architectures share the schedule and differ only
 /// in the cycles before the first issue: none for the seed's; for the
-/// stream's, max(m + 1 - n, streamReadLatency) (BPACCEL_READ_LATENCY, 0 for
+/// stream's, streamReadLatency (BPACCEL_READ_LATENCY, 0 for
 /// the seed's, so passing the header's values always models the hardware built).
 /// Batches of up to `batchCells` cells (BPACCEL_BATCH_CELLS) cost what the
 /// hardware's front end adds: one cycle per batch and one per cell; with

@@ -230,8 +230,7 @@ void RtlBackend::batchOnHardware(std::span<const std::span<const KeyBox>> cells,
     const bool boxOffered = cell < cells.size();
     top.io_load_valid = boxOffered;
     if (boxOffered)
-      setBox(top, cells[cell][batchLoadIndex(box, cells[cell].size(), BPACCEL_M, BPACCEL_CAPACITY,
-                                             BPACCEL_BATCH_OVERLAPS_LOADS != 0)]);
+      setBox(top, cells[cell][box]);
     const bool ready = consumerReady_(cycle);
     top.io_result_ready = ready;
     settle();

@@ -44,8 +44,7 @@ BothRuns runBoth(Backend& rtl, Backend& model, const std::vector<Aabb>& boxes) {
 // stalls, from the header's closed form (independent of ModelBackend).
 std::uint64_t expectedRunCycles(std::uint64_t n) {
   if (n < 2) return 0;
-  const std::uint64_t startup =
-      BPACCEL_ARCH_STREAM ? std::max<std::uint64_t>(BPACCEL_M + 1 > n ? BPACCEL_M + 1 - n : 0, BPACCEL_READ_LATENCY) : 0;
+  const std::uint64_t startup = BPACCEL_ARCH_STREAM ? BPACCEL_READ_LATENCY : 0;
   return startup + scheduleIssueCycles(n, BPACCEL_M) + BPACCEL_RUN_OVERHEAD_CYCLES;
 }
 

@@ -113,6 +113,11 @@ case class AccelParams(
     */
   val overlapsLoads: Boolean = arch == Arch.Stream
 
+  /** Objects the loader marks by a one-hot lane as they arrive: block 0's A
+    * objects 0 .. m-1, and for the stream object m too (its head registers).
+    */
+  val headLanes: Int = if (arch == Arch.Stream) m + 1 else m
+
   /** Bits of an object index 0 .. capacity-1. */
   val indexWidth: Int = log2Ceil(capacity).max(1)
 
@@ -121,19 +126,6 @@ case class AccelParams(
     */
   val memoryRows: Int = if (arch == Arch.Stream) 2 << indexWidth else depth
 
-  /** Whether a batch sends a cell of n boxes "head last": objects m+1 .. n-1
-    * first, into the memory while the last cell still runs, then objects
-    * 0 .. m, which enter the B window and the first A block straight from the
-    * load port once the last cell stopped issuing. Other cells (and single
-    * runs) are sent in index order.
-    */
-  def loadsHeadLast(n: Long): Boolean = overlapsLoads && n >= m + 2 && n <= capacity
-
-  /** The object index of the box sent at `position` in a batch's cell of n boxes. */
-  def batchLoadIndex(position: Int, n: Int): Int =
-    if (!loadsHeadLast(n)) position
-    else if (position < n - m - 1) m + 1 + position
-    else position - (n - m - 1)
 
   require(
     memoryStyle != MemoryStyle.Ecp5OutputRegister || memoryRows <= RegisteredReadMemory.maxEcp5Rows,
@@ -175,17 +167,15 @@ case class AccelParams(
     */
   val runOverheadCycles: Int = pipelineLatency + 1
 
-  /** Cycles between the start and the first issue of a run of n >= 2 objects,
-    * exactly n of them loaded (as the host does; with more loaded the stream's
-    * startup can only be shorter). Stream: the window must hold objects 1..m
-    * (the load shifted in objects 1..min(n-1, m), so m+1-n more shifts when
-    * n <= m) while the first readLatency reads travel to the window's entry;
-    * both at once.
+  /** Cycles between the start and the first issue of a run of n >= 2
+    * objects. Stream: the first readLatency reads travel to the window's
+    * entry; the window and block 0's A objects are copied from the head
+    * registers meanwhile.
     */
   def startupCycles(n: Long): Long = arch match {
     case Arch.Seed                => 0
     case Arch.Stream if n < 2     => 0
-    case Arch.Stream              => math.max(m + 1 - n, readLatency.toLong)
+    case Arch.Stream              => readLatency.toLong
   }
 
   /** Every cycle of a run of n objects beyond issues and stalls. */

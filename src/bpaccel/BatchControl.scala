@@ -15,12 +15,11 @@ import chisel3.util._
   *
   * Where the architecture overlaps loads ([[AccelParams.overlapsLoads]]),
   * the head moves on to the next count as soon as its cell starts, so the
-  * next cell loads while the current one runs: its boxes past object m
-  * (sent first, [[AccelParams.loadsHeadLast]]) go to the memory's other
-  * bank at once; objects 0 .. m enter the B window from the load port, so
-  * they wait until the engine stops issuing (`engineActive` falls). Without
-  * overlap the head takes the next count only when its cell has ended, and
-  * no box is admitted while a cell runs.
+  * next cell loads while the current one runs: its boxes go to the memory's
+  * other bank, and objects 0 .. m to the engine's head registers, which the
+  * start copied into the B window and A block before. Without overlap the
+  * head takes the next count only when its cell has ended, and no box is
+  * admitted while a cell runs.
   *
   * Per cell the front end spends one cycle of its own, the one that ends
   * the cell; per batch one more, the cycle that accepts its first count (it
@@ -31,8 +30,6 @@ class BatchControl(p: AccelParams) extends Module {
     val cells      = Flipped(Decoupled(UInt(p.countWidth.W)))
     val hostStart  = Input(Bool()) // the host offers a single start: it wins over a batch's first count
     val runBusy    = Input(Bool()) // run control is running a run
-    val engineActive = Input(Bool()) // the engine is starting up or issuing: its B window is in use
-    val nextHead   = Input(Bool()) // the loader's next box is object 0 .. m
     val loadFire   = Input(Bool()) // a box was accepted
     val active     = Output(Bool()) // a batch is under way
     val begin      = Output(Bool()) // this cycle accepts a batch's first count
@@ -86,11 +83,7 @@ class BatchControl(p: AccelParams) extends Module {
   assert(active || tailIn.ready, "the batch front end's tail queue held a count outside a batch")
   io.begin := io.cells.valid && !active && takesFirstCount
 
-  // Objects 0 .. m wait while the engine's window is in use (only a run of
-  // this batch can use it: a batch begins only when no run is busy).
-  val windowFree =
-    if (p.overlapsLoads && !p.has(Fault.HeadBoxesIgnoreWindow)) !io.nextHead || !io.engineActive else true.B
-  io.loadReady   := wantsBox && windowFree
+  io.loadReady   := wantsBox
   io.start.valid := loading && !wantsBox && !running
   io.start.bits  := current
   // A register, not cellsDone =/= 0: a 32-bit test in front of every counter's enable was the next m = 8 critical path.

@@ -15,9 +15,8 @@ import chisel3.util._
   * and no results, never with a partial answer.
   *
   * Batches: push the box counts of up to `batchCells` cells on `cells`, then
-  * stream all their boxes on `load`, each cell in the order
-  * [[AccelParams.batchLoadIndex]] gives (head last where the architecture
-  * overlaps loads); [[BatchControl]] runs the cells one after the other,
+  * stream all their boxes on `load`, in cell order, each cell in index
+  * order; [[BatchControl]] runs the cells one after the other,
   * loading the next while the current one runs where it can, and result
   * beats carry their cell's index. A start is refused while a batch is under way.
   *
@@ -52,8 +51,6 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   batch.io.hostStart := io.start.valid
   batch.io.runBusy   := control.io.status.busy
   batch.io.loadFire  := io.load.fire
-  batch.io.engineActive := engine.io.activity.active
-  batch.io.nextHead     := loader.io.nextHead
 
   // The run control's start: the host's outside a batch, the front end's within one.
   val start = Wire(Decoupled(UInt(p.countWidth.W)))
@@ -63,7 +60,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   assert(!batch.io.start.valid || start.ready, "the batch front end started a cell while a run was busy")
   // Starts clear the loader, and so does a batch's first count: its first
   // box is object 0. With overlapped loads every count the head takes starts
-  // its cell's numbering (head last or not) while the last cell may still run.
+  // its cell's numbering while the last cell may still run.
   val clear = start.fire || (if (p.overlapsLoads) batch.io.take.valid else batch.io.begin)
 
   // A start or a batch's first count in the same cycle wins, so a box is never loaded into the next run by accident.
@@ -75,10 +72,6 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   loader.io.load.valid := io.load.fire
   loader.io.load.bits  := io.load.bits
   loader.io.clear      := clear
-  for (headLast <- loader.io.headLast) {
-    headLast.valid := batch.io.take.valid
-    headLast.bits  := batch.io.take.bits
-  }
 
   control.io.start <> start
   control.io.accumulate    := batch.io.accumulate

@@ -87,10 +87,10 @@ class AccelInfo extends Bundle {
   val capacity          = UInt(32.W)
   val keyWidth          = UInt(8.W)
   val runOverheadCycles = UInt(8.W)
-  val readLatency       = UInt(8.W) // stream: startup is max(m + 1 - n, readLatency) cycles
+  val readLatency       = UInt(8.W) // stream: startup is readLatency cycles
   val batchCells        = UInt(16.W) // cell counts the batch queue holds
   val cellTagWidth      = UInt(8.W)  // bits of a result beat's cell tag
-  val batchOverlapsLoads = Bool()    // a batch loads its next cell while one runs; cells are sent head last
+  val batchOverlapsLoads = Bool()    // a batch loads its next cell while one runs
 }
 
 /** The ports every architecture's engine offers the shared top level. */

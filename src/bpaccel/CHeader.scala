@@ -55,8 +55,8 @@ object CHeader {
        | * A run of n >= 2 objects with a consumer that never stalls takes
        | * startup(n) + issue_cycles(n) + BPACCEL_RUN_OVERHEAD_CYCLES cycles, where
        | * issue_cycles(n) = sum over b = 0 .. (n-2)/M of (n - 1 - b*M) and
-       | * startup(n) = 0 for the seed architecture, max(M + 1 - n,
-       | * BPACCEL_READ_LATENCY) for the stream architecture;
+       | * startup(n) = 0 for the seed architecture, BPACCEL_READ_LATENCY for
+       | * the stream architecture;
        | * runs with n < 2 take no cycles.
        | * Counters: load_cycles counts the cycles from a run's first accepted box
        | * to the cycle that accepts its start, both included (n + 1 when the
@@ -65,9 +65,8 @@ object CHeader {
        | * device busy for load_cycles + cycles.
        | * Batches: push up to BPACCEL_BATCH_CELLS cell counts on `cells`, then
        | * stream the boxes of all cells in cell order on `load`, with no start.
-       | * With BPACCEL_BATCH_OVERLAPS_LOADS a cell of M + 2 <= n <= CAPACITY
-       | * boxes is sent head last: objects M+1 .. n-1, then 0 .. M; the device
-       | * loads it while the cell before runs. Other cells go in index order.
+       | * With BPACCEL_BATCH_OVERLAPS_LOADS the device loads each cell while
+       | * the cell before runs.
        | * Beats carry `cell` (index in the batch mod 2^BPACCEL_CELL_TAG_WIDTH)
        | * and indices local to their cell; done rises when the last cell ended.
        | * Counters over a batch count each of its cycles once: cycles those of

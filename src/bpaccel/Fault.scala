@@ -27,17 +27,16 @@ object Fault {
   case object SkipSecondBlockAtMPlus2 extends Fault("a run of m+2 objects skips its second block")
   /** The comparators test min < max instead of min <= max: touching boxes are missed. */
   case object StrictCompare extends Fault("comparators miss touching boxes")
-  /** The stream's startup owes the window m+1-n shifts, as a first version did, although more boxes were
-    * loaded: for n <= m lane 0 then holds object n, not object 1 (a real bug, found by the whole-run proof). */
-  case object WindowFillFromCount extends Fault("the stream's startup fill counts from n, not from the boxes loaded")
+  /** The stream's start copies objects 0 .. m-1 into the window instead of 1 .. m: lane k meets itself. */
+  case object HeadCopyOffByOne extends Fault("the stream's start copies the head registers into the window one lane off")
   /** The stream's window enables, computed a cycle ahead, ignore the result queue's back-pressure. */
   case object LookaheadIgnoresRoom extends Fault("the stream's look-ahead window enables ignore back-pressure")
   /** The batch front end does not count cells of fewer than two objects: later cells get the wrong tag. */
   case object CellCounterSkipsShortCells extends Fault("the batch's cell counter skips cells of 0 or 1 objects")
   /** The batch front end takes the next count only when a cell ends, as before loads overlapped runs. */
   case object BatchLoadsInSeries extends Fault("the batch loads its next cell only after the last one ended")
-  /** Objects 0 .. m of a batch's next cell are taken while the run before still uses the B window. */
-  case object HeadBoxesIgnoreWindow extends Fault("the next cell's objects 0 .. m enter the window while a run uses it")
+  /** The stream copies the head registers two cycles late, after a batch's next cell may have written them. */
+  case object HeadCopiedLate extends Fault("the stream's start copies the head registers two cycles late")
 
   val all: Seq[Fault] = Seq(
     CreditOneTooMany,
@@ -49,10 +48,10 @@ object Fault {
     RepeatLastBeat,
     SkipSecondBlockAtMPlus2,
     StrictCompare,
-    WindowFillFromCount,
+    HeadCopyOffByOne,
     LookaheadIgnoresRoom,
     CellCounterSkipsShortCells,
     BatchLoadsInSeries,
-    HeadBoxesIgnoreWindow
+    HeadCopiedLate
   )
 }

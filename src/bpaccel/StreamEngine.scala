@@ -16,20 +16,19 @@ import chisel3.util._
   *
   * A blocks sit in registers (`a`). The next block's A objects base+m+k pass
   * the window's top lane in cycle k of the current block; `aNext` captures
-  * them there and is copied into `a` at the block change. Block 0's A
-  * objects and the first window are taken from the load stream the same
-  * way (the window shifts in objects 0 .. m while they are loaded).
+  * them there and is copied into `a` at the block change.
   *
-  * No register has a multiplexer in front of it: every window lane loads
-  * from its neighbour, `aNext` from the top lane, `a` from `aNext` (enables
-  * only). The window's entry chooses between the load port and the memory.
+  * Objects 0 .. m are kept, as they are loaded, in head registers of their
+  * own (`headRegs`, written by lane, enables only). The cycle after a start
+  * copies them at once: objects 1 .. m into the window, 0 .. m-1 into
+  * `aNext`. So a run needs no window shifts of its own before it issues,
+  * and a batch's next cell loads all its boxes, these included, while the
+  * current cell runs. Only the window and `aNext` have a multiplexer in
+  * front of them (neighbour or head register, top lane or head register);
+  * `a` loads from `aNext`.
   *
-  * Startup after the start: the first readLatency reads travel to the entry
-  * and, when fewer than m+1 boxes were loaded, the window shifts m+1-loaded
-  * more times so object 1 reaches lane 0; both at once. (Counted from the
-  * loads, not from n: a start may use fewer boxes than were loaded, and the
-  * window then already holds objects 1 .. m.) Pipeline: comparator
-  * register, AND register.
+  * Startup after the start: the first readLatency reads travel to the
+  * window's entry. Pipeline: comparator register, AND register.
   */
 class StreamEngine(p: AccelParams) extends Engine(p) {
   private val m = p.m
@@ -52,10 +51,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val loadedBox = Wire(Valid(new LoadWrite(p)))
   loadedBox.valid := RegNext(io.write.valid, false.B)
   loadedBox.bits  := RegNext(io.write.bits)
-  // Objects 0 .. m enter the window from here; a batch's other boxes may
-  // arrive while a run reads the other bank, and only go to the memory.
-  val headWrite  = io.write.valid && io.write.bits.head
-  val loadedHead = RegNext(headWrite, false.B)
 
   // ---- memory banks: a batch loads its next cell into one while a run reads the other ----
   // Every accepted start turns the writes to the other bank; its run reads
@@ -80,21 +75,13 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // ---- run state ----
   val starting = RegInit(false.B)
   val issuing  = RegInit(false.B)
-  // Window shifts still needed at startup, as a thermometer like `owes`
-  // below (bit k: more than k+1 left; more than 0 is `filling`), so that the
-  // enables' look-ahead reads single bits.
-  val fillMoreThan1 = Reg(UInt(m.W))
   val primeLeft = Reg(UInt(log2Ceil(p.readLatency + 1).W)) // cycles until the first read reaches the entry
-
-  // Registered flags only in front of the window's enables (192m flip-flops).
-  val filling = RegInit(false.B) // starting and window shifts still needed
-  val issue   = issuing && advance
+  val issue     = issuing && advance
 
   // The next values of the flags behind the wide enables (window, A block):
   // the enables are computed from them a cycle ahead, see `replicatedEnable`.
   // `*Carry`: the next value unless a run is launched in this cycle.
   val startingCarry = WireDefault(starting)
-  val fillingCarry  = WireDefault(filling)
   val issuingNext   = WireDefault(issuing)
   val issueNext     = issuingNext && io.room // `issue` in the next cycle (advance is io.room registered)
 
@@ -189,73 +176,67 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     "the stream's read credits do not match the queue"
   )
 
-  // ---- the window: lane k holds object s+k ----
-  val window = Reg(Vec(m, new Entry))
-  // Objects 0 .. m shift in as they are loaded, one cycle after the load
-  // port took them (`loadedBox`): the load's valid and ready would otherwise reach the
-  // window's enables through the port logic (the m = 8 critical path once
-  // the load-ready was a register). The last box shifts in at the latest in
-  // the cycle of the launch, and the window is not used before the cycle
-  // after it. The startup still owes the window m+1 minus the boxes shifted
-  // in since the last start (a start: the next box is object 0); `owes`
-  // holds that count as a thermometer, bit k set while it is more than k, so
-  // that counting one down is a shift and the look-ahead of the window's
-  // enables reads single bits instead of a subtraction (stream m = 64).
-  val owesAll    = ((BigInt(1) << (m + 1)) - 1).U((m + 1).W) // m+1 shifts owed: a start
-  val owes       = RegInit(owesAll)
-  val takesLoads = owes(0)
-  val loadShift  = loadedHead && takesLoads
-  val owesAfterShift = Mux(loadShift, owes >> 1, owes) // at most m+1 boxes shift in
-  val owesNext       = Mux(io.clear, owesAll, owesAfterShift)
-  owes := owesNext
-  val takesLoadsNext = owesNext(0)
-  // A launched run fills the window while fewer than m+1 boxes shifted in
-  // (the last box may shift in during the launch's cycle).
-  val launchFills =
-    if (p.has(Fault.WindowFillFromCount)) io.prepare.bits <= m.U else owesAfterShift(0)
-  val startingNext = io.launch.valid || startingCarry
-  val fillingNext  = Mux(io.launch.valid, launchFills, fillingCarry)
-  starting := startingNext
+  starting := io.launch.valid || startingCarry
   issuing  := issuingNext
-  filling  := fillingNext
   // The look-ahead of the enables takes every accepted start (`io.prepare`)
   // for a launch, so that the start's decoded error checks stay out of it
   // (stream m = 32's critical path ran from them into the window's enable
-  // copies). A start that does not launch therefore shifts the window and
-  // copies the A block once, in the next cycle: harmless, as the start
-  // emptied the loader, the next run's m+1 window shifts all come after that
-  // cycle (its first box reaches the window two cycles after the start at
-  // the earliest), and its startup copies the A block again.
-  val startingSoon = io.prepare.valid || startingCarry
-  val fillingSoon  = Mux(io.prepare.valid, launchFills, fillingCarry)
+  // copies). A start that does not launch therefore copies the head
+  // registers and the A block once, in the next cycle: harmless, as no run
+  // uses them then and the next start copies both again.
+  val startingSoon    = io.prepare.valid || startingCarry
   val unlaunchedStart = RegNext(io.prepare.valid && !io.launch.valid, false.B)
-  val entry = Wire(new Entry)
-  entry.box := Mux(loadedHead, loadedBox.bits.box.asUInt, readHead.io.deq.bits.box)
-  entry.tag := Mux(loadedHead, tagOf(loadedBox.bits.index), readHead.io.deq.bits.tag)
-  // Objects 0 .. m come only while the window is free: the batch front end holds them back.
-  assert(!(loadedHead && (starting || issuing)), "a box entered the window while a run used it")
+
+  // ---- objects 0 .. m: kept in head registers as they are loaded ----
+  // Written by the loader's one-hot lane (registered beside the box), so
+  // each register has an enable and no multiplexer. A batch writes its next
+  // cell's head here while the current cell runs: the start copied these
+  // registers in the cycle after it, and the next cell's boxes come later.
+  val headRegs = Reg(Vec(m + 1, new Entry))
+  val headWrites = Seq.tabulate(m + 1)(k => loadedBox.valid && loadedBox.bits.headLane(k))
+  for (k <- 0 to m) when(headWrites(k)) {
+    headRegs(k).box := loadedBox.bits.box.asUInt
+    headRegs(k).tag := tagOf(loadedBox.bits.index)
+  }
+  // The cycle after every accepted start copies the head registers into the
+  // window and aNext (an unlaunched start's copy is harmless: the next start
+  // copies again). Per lane, computed a cycle ahead like the other enables.
+  val copyAfter = if (p.has(Fault.HeadCopiedLate)) 3 else 1 // cycles after the start
+  val copyNext  = ShiftRegister(io.prepare.valid, copyAfter - 1, false.B, true.B)
+  val copying   = RegNext(copyNext, false.B)
+  val headCopy  = replicatedEnable("headCopy", next = copyNext, now = copying)
+  // headCopiedBeforeWritten: no head box of the next cell is written before
+  // the copy of this one (the front end takes the next count at the start,
+  // so its first box is written two cycles later at the earliest).
+  val copyPending = RegInit(false.B)
+  when(io.prepare.valid) { copyPending := true.B }.elsewhen(copying) { copyPending := false.B }
+  assert(!(copyPending && headWrites.reduce(_ || _) && !io.prepare.valid),
+    "a head register was written before the start's copy of it")
+
+  // ---- the window: lane k holds object s+k ----
+  val window = Reg(Vec(m, new Entry))
+  val entry  = readHead.io.deq.bits
   val windowShift = replicatedEnable(
     "windowShift",
-    next = (headWrite && takesLoadsNext) || fillingSoon ||
-      (issuingNext && (io.room || p.has(Fault.LookaheadIgnoresRoom).B)),
-    now = loadShift || filling || issue
+    next = issuingNext && (io.room || p.has(Fault.LookaheadIgnoresRoom).B),
+    now = issue
   )
-  for (k <- 0 until m) when(windowShift(k)) { window(k) := (if (k == m - 1) entry else window(k + 1)) }
+  // The window takes objects 1 .. m from the head registers at the copy.
+  private val copiedToLane = if (p.has(Fault.HeadCopyOffByOne)) 0 else 1
+  for (k <- 0 until m) {
+    when(headCopy(k)) {
+      window(k) := headRegs(k + copiedToLane)
+    }.elsewhen(windowShift(k)) {
+      window(k) := (if (k == m - 1) entry else window(k + 1))
+    }
+  }
+  assert(!(copying && issue), "the window was copied and shifted in one cycle")
 
   // ---- A blocks ----
   val a     = Reg(Vec(m, new Entry))
   val aNext = Reg(Vec(m, new Entry))
-  // Block 0: object k (< m) is in the top lane the cycle after it shifted in.
-  // The last box of a run may shift in at the launch, so its capture may come
-  // after the startup copied aNext into a: harmless, as object n-1 is never
-  // an A object that is compared (no object follows it).
-  // Decoded per lane from the loader's one-hot lane, not by comparing the
-  // loaded index with k (that compare sat in front of lane k's 192 enables:
-  // stream m = 64's critical path, 82.1 MHz). `loadedTop` is the capture as
-  // it happens, the reference the look-ahead below is checked against.
-  val loadsTopNext = Seq.tabulate(m)(k => loadShift && loadedBox.bits.firstBlockLane(k))
-  val loadedTop    = loadsTopNext.map(RegNext(_, false.B))
-  // Later blocks: cycle k of a block finds object base+m+k in the top lane.
+  // Block 0's A objects come from the head registers at the copy; later
+  // blocks': cycle k of a block finds object base+m+k in the top lane.
   val capture     = Reg(UInt(m.W)) // one-hot: lane of aNext to fill at this issue
   val captureNext = WireDefault(capture)
   capture := captureNext
@@ -264,10 +245,16 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // issue && capture(k) (stream m = 64's critical path, 83.7 MHz, 11.0 ns of wire).
   val aNextLoad = laneEnables(
     "aNextLoad",
-    next = Seq.tabulate(m)(k => (issueNext && captureNext(k)) || loadsTopNext(k)),
-    now = Seq.tabulate(m)(k => (issue && capture(k)) || loadedTop(k))
+    next = Seq.tabulate(m)(k => issueNext && captureNext(k)),
+    now = Seq.tabulate(m)(k => issue && capture(k))
   )
-  for (k <- 0 until m) when(aNextLoad(k)) { aNext(k) := window(m - 1) }
+  for (k <- 0 until m) {
+    when(headCopy(k)) {
+      aNext(k) := headRegs(k)
+    }.elsewhen(aNextLoad(k)) {
+      aNext(k) := window(m - 1)
+    }
+  }
 
   // ---- the schedule ----
   val base      = Reg(UInt(p.countWidth.W))
@@ -308,9 +295,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   for (k <- 0 until m) when(aLoad(k)) { a(k) := aNext(k) }
   when(starting) {
     when(primeLeft =/= 0.U) { primeLeft := primeLeft - 1.U }
-    fillMoreThan1 := fillMoreThan1 >> 1
-    fillingCarry  := fillMoreThan1(0)
-    when(primeLeft <= 1.U && !fillMoreThan1(0)) {
+    when(primeLeft <= 1.U) {
       startingCarry := false.B
       issuingNext  := true.B
     }
@@ -345,9 +330,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   when(io.prepare.valid) {
     val count = io.prepare.bits // >= 2 when it launches
     primeLeft := p.readLatency.U
-    // The last box may shift in during this cycle.
-    fillMoreThan1 := (if (p.has(Fault.WindowFillFromCount)) VecInit((0 until m).map(k => count < (m - k).U)).asUInt // m+1-count > k+1
-                      else owesAfterShift >> 1)
     base      := 0.U
     s         := 1.U
     left      := count - 2.U

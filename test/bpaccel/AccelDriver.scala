@@ -137,8 +137,7 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
     */
   def batch(cells: Seq[Seq[Box]], ready: Int => Boolean = _ => true): BatchOutcome = {
     val counts = cells.map(_.length)
-    // Each cell in the order the device numbers it (head last where loads overlap runs).
-    val boxes  = cells.flatMap(c => c.indices.map(position => c(p.batchLoadIndex(position, c.length))))
+    val boxes  = cells.flatten // each cell in index order
     var nextCount, nextBox = 0
     var began = false
     val pairs = Seq.newBuilder[(Int, Int, Int)]

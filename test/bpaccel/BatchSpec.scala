@@ -133,7 +133,7 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
       }
     }
 
-  it should "hide each cell's boxes past object m under the run before it, its runs costing what single runs cost (stream)" in {
+  it should "hide each cell's boxes under the run before it, its runs costing what single runs cost (stream)" in {
     val p = configurations(3)
     withDriver(p) { (dut, drv) =>
       val rng   = new Random(11)
@@ -147,11 +147,16 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
       batch.cycles shouldBe singles.map(_.cycles).sum + perCells
       batch.issueCycles shouldBe singles.map(_.issueCycles).sum
       batch.hits shouldBe singles.map(_.hits).sum
-      // The loads the runs hid: every box past object m of a cell after the first, where the run before was long enough.
+      // The loads the runs hid: at least the whole second cell, which loads under the first cell's run.
       val serialLoad = singles.map(_.loadCycles).sum + perBatch
       withClue(s"batch load cycles ${batch.loadCycles} against ${serialLoad} in series: ") {
-        batch.loadCycles should be < serialLoad - (p.capacity - p.m - 1)
+        batch.loadCycles should be < serialLoad - p.capacity
       }
+      // Two full cells: the second's boxes, objects 0 .. m included, all load
+      // under the first's run, so only the second's start cycle is left.
+      val pair = drv.batch(cells.take(2))
+      checkBatch(p, cells.take(2), pair, consumerNeverStalls = true)
+      pair.loadCycles shouldBe singles.head.loadCycles + frontEndCycles(2)._1 + 1
       val after = drv.run(cells(4))
       checkRun(p, cells(4), after, consumerNeverStalls = true)
     }
@@ -167,8 +172,7 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
     }
   }
 
-  // Each configuration costs a Verilator build: reuse the two above. The
-  // stream's over-capacity cell is sent in index order between head-last ones.
+  // Each configuration costs a Verilator build: reuse the two above.
   for (p <- Seq(configurations(1), configurations(3)))
     it should s"end a cell over the capacity with LoadOverflow and no beats of it, consuming its boxes, and finish the batch (${p.arch.name})" in {
       withDriver(p) { (dut, drv) =>
@@ -236,11 +240,12 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
     }
   }
 
-  it should "fail when the next cell's objects 0 .. m enter the window while a run uses it (mutant)" in {
-    val p = configurations(3).copy(faults = Set(Fault.HeadBoxesIgnoreWindow))
+  it should "fail when the next cell's objects 0 .. m are written before the start copied the head registers (mutant)" in {
+    val p = configurations(3).copy(faults = Set(Fault.HeadCopiedLate))
     withDriver(p) { (dut, drv) =>
       val rng   = new Random(19)
-      val cells = Seq(p.capacity, p.capacity, 2 * p.m).map(cellBoxes(rng, p, _))
+      // Cells of at most m+1 boxes are sent in order: the next one's object 0 comes right after the start.
+      val cells = Seq(p.capacity, p.m + 1, p.m, 2).map(cellBoxes(rng, p, _))
       // The engine's own check stops the simulation; were it absent, the pairs would be wrong.
       intercept[chiseltest.ChiselAssertionError](checkBatch(p, cells, drv.batch(cells), consumerNeverStalls = true))
     }

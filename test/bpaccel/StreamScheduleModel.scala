@@ -7,10 +7,10 @@ package bpaccel
   * in each lane. It knows nothing of window starts, lane masks or formulas:
   * a lane is compared when its B object belongs to the block being run.
   *
-  *  - Loading shifts objects 0 .. m into the window's top lane; object k < m
-  *    is copied from the top lane into A register k the cycle after.
-  *  - After the start the window shifts (taking nothing useful) until object 1
-  *    is in lane 0, while the first reads travel to the window's entry.
+  *  - Loading keeps objects 0 .. m aside. The start copies objects 1 .. m
+  *    into window lanes 0 .. m-1 and objects 0 .. m-1 into the A registers
+  *    (lanes past the loaded objects hold nothing useful); then the first
+  *    reads travel to the window's entry.
   *  - The memory is read in block order: block b's B objects b*m+1 .. n-1,
   *    then block b+1's. Each issue shifts the window by one lane, the next
   *    object of that order entering the top lane.
@@ -38,16 +38,10 @@ object StreamScheduleModel {
       for (k <- 0 until m - 1) window(k) = window(k + 1)
       window(m - 1) = item
     }
-    val aNext = Array.fill(m)(-1)
-    // Loading: objects 0 .. m enter the window; the loaded ones are block 0's stream from object 1.
-    for (j <- 0 until n if j <= m) {
-      shiftIn(if (j == 0) Garbage else Item(j, 0))
-      if (j < m) aNext(j) = j // "copied from the top lane": it is object j
-    }
-    // Startup: shift until object 1 is in lane 0.
-    var fill = 0
-    while (window(0) != Item(1, 0)) { shiftIn(Garbage); fill += 1 }
-    val startup = math.max(fill, readLatency)
+    // The start's copy: lane k takes object k+1, A register k object k; block 0's stream from object 1.
+    for (k <- 0 until m) window(k) = if (k + 1 < n) Item(k + 1, 0) else Garbage
+    val aNext = Array.tabulate(m)(k => if (k < n) k else -1)
+    val startup = readLatency
 
     val out   = Vector.newBuilder[Vector[Lane]]
     var a     = aNext.clone()

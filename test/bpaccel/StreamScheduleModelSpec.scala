@@ -40,7 +40,7 @@ class StreamScheduleModelSpec extends AnyFlatSpec with Matchers {
     }
   }
 
-  it should "start up in max(m + 1 - n, readLatency) cycles, the closed form" in {
+  it should "start up in readLatency cycles, the closed form" in {
     for ((m, n) <- cases if n >= 2; l <- latencies) withClue(s"m=$m n=$n readLatency=$l: ") {
       val p = AccelParams(m = m, capacity = 1024, memoryOutputStages = l - 2, arch = Arch.Stream)
       StreamScheduleModel.run(n, m, l).startupCycles.toLong shouldBe p.startupCycles(n)
