@@ -12,7 +12,7 @@ set(_bpaccel_src ${CMAKE_CURRENT_LIST_DIR}/../src)
 # Public headers: the ones a user of the broad phase or the backends reaches,
 # and the configuration the model backend is built for (bpaccel_params.h).
 target_sources(bpaccel_core PUBLIC FILE_SET HEADERS BASE_DIRS ${_bpaccel_src} ${BPACCEL_VERILOG_DIR} FILES
-  ${_bpaccel_src}/types.hpp ${_bpaccel_src}/all_pairs_kernel.hpp ${_bpaccel_src}/backend.hpp ${_bpaccel_src}/keys.hpp ${_bpaccel_src}/kd_tree.hpp
+  ${_bpaccel_src}/types.hpp ${_bpaccel_src}/all_pairs_kernel.hpp ${_bpaccel_src}/backend.hpp ${_bpaccel_src}/async_backend.hpp ${_bpaccel_src}/keys.hpp ${_bpaccel_src}/kd_tree.hpp
   ${_bpaccel_src}/partition.hpp ${_bpaccel_src}/uniform_grid.hpp
   ${_bpaccel_src}/broad_phase.hpp ${_bpaccel_src}/timeline.hpp ${_bpaccel_src}/box_file.hpp ${BPACCEL_VERILOG_DIR}/bpaccel_params.h)
 # Installed users include <bpaccel/...> (the file set adds include/bpaccel/).

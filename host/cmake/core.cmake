@@ -5,6 +5,7 @@ add_library(bpaccel_core STATIC
   ${CMAKE_CURRENT_LIST_DIR}/../src/keys.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/box_file.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/backend.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/../src/async_backend.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/all_pairs_kernel.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/partition.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/kd_tree.cpp
@@ -14,5 +15,6 @@ add_library(bpaccel_core STATIC
 # A build-tree path: the installed package (bullet_drop_in.cmake) adds its own.
 target_include_directories(bpaccel_core PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_LIST_DIR}/../src>)
 find_package(TBB REQUIRED)
-target_link_libraries(bpaccel_core PUBLIC fmt::fmt TBB::tbb)
+find_package(Threads REQUIRED)  # AsyncBackend's thread
+target_link_libraries(bpaccel_core PUBLIC fmt::fmt TBB::tbb Threads::Threads)
 target_compile_options(bpaccel_core PRIVATE -Wall -Wextra -Wpedantic)

@@ -1,12 +1,15 @@
 #include "broad_phase.hpp"
 
+#include <future>
 #include <numeric>
 #include <stdexcept>
+#include <utility>
 
 #include <fmt/format.h>
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
+#include "async_backend.hpp"
 #include "keys.hpp"
 
 namespace bpaccel {
@@ -24,7 +27,10 @@ enum Keep : int { kCross = 1, kFirstInside = 2, kSecondInside = 4 };
 struct BroadPhase::Worker {
   std::unique_ptr<Backend> owned;
   Backend* backend = nullptr;
+  std::unique_ptr<AsyncBackend> async;  // with asynchronous hand-overs: the backend on a thread of its own
   std::size_t cellsPerBatch = 1;
+  // The device's thread is stopped (after its last batch) before the buffers it reads go.
+  ~Worker() { async.reset(); }
   std::vector<KeyBox> gathered;         // a chunk pair's boxes, packed for the backend
   std::vector<Pair> local;              // pairs of one hand-over, indices local to each cell
   std::vector<Pair> out;                // this worker's share of the frame's pairs
@@ -33,26 +39,37 @@ struct BroadPhase::Worker {
   Clock::time_point frameStart;
   std::vector<RunRecord> runs;
 
-  // The batch being filled: its cells' items and boxes (referred to where
-  // they outlive the batch, else copied back to back), and how to filter each
-  // cell's pairs. A cell's region is copied: the tree's leaf list grows (and
-  // moves) while the batch fills.
+  // A batch: its cells' items and boxes (referred to where they outlive the
+  // batch, else copied back to back), and how to filter each cell's pairs.
+  // A cell's region is copied: the tree's leaf list grows (and moves) while
+  // the batch fills.
   struct PendingCell {
     std::span<const std::uint32_t> items;  // when referred to
     std::span<const KeyBox> boxes;
     std::span<const std::uint8_t> below;   // the partition's below() bits, when referred to and it has them
     bool copied = false;
-    std::size_t begin = 0, count = 0;      // when copied: where in pendingItems and pendingBoxes
+    std::size_t begin = 0, count = 0;      // when copied: where in the batch's items and boxes
     Cell region{};
     bool hasRegion = false;
     std::size_t splitAt = 0;
     int keep = 0;
   };
-  std::vector<PendingCell> pending;
-  std::vector<std::uint32_t> pendingItems;
-  std::vector<KeyBox> pendingBoxes;
-  std::vector<std::span<const KeyBox>> cellSpans;
-  std::vector<std::span<const std::uint32_t>> cellItems;
+  struct Batch {
+    std::vector<PendingCell> cells;
+    std::vector<std::uint32_t> items;
+    std::vector<KeyBox> boxes;
+    std::vector<std::span<const KeyBox>> cellSpans;  // what the backend gets, made at the hand-over
+    std::vector<std::span<const std::uint32_t>> cellItems;
+    void clear() {
+      cells.clear();
+      items.clear();
+      boxes.clear();
+    }
+  };
+  Batch filling;   // the batch being filled
+  Batch inFlight;  // asynchronous only: the batch the device has, until its pairs are decoded
+  std::future<BatchResult> inFlightResult;
+  RunRecord inFlightRecord;
   std::vector<std::size_t> cellEnds;
 
   // One device cell: a partition cell or a chunk pair. `packed`: its boxes in item
@@ -64,7 +81,12 @@ struct BroadPhase::Worker {
               std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep, bool lasting);
   void runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
               std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep);
-  void flush();  // hands the pending batch over, if any
+  void flush();   // hands the batch being filled over, if any
+  void finish();  // flush, then (asynchronous) wait for the batch in flight and decode it
+  void collect(); // asynchronous: waits for the batch in flight and decodes it
+  void startFrame(Clock::time_point start);
+  // Appends a batch's kept pairs, given the backend's pairs and cell ends for it.
+  void decodeBatch(const Batch& batch, std::span<const Pair> pairs, std::span<const std::size_t> ends);
   // One hand-over to the backend (`run` fills the record's counters), timed
   // and recorded for the pipeline model, then `decode` of its pairs.
   template <typename Run, typename Decode>
@@ -110,17 +132,29 @@ BroadPhase::BroadPhase(Backend& backend, std::optional<std::size_t> cellSize, st
 }
 
 BroadPhase::BroadPhase(const BackendFactory& makeBackend, std::optional<std::size_t> cellSize, std::size_t threads,
-                       std::size_t cellsPerBatch, PartitionKind partition)
-    : cellSize_(cellSize), cellsPerBatch_(cellsPerBatch), partition_(makePartition(partition)) {
+                       std::size_t cellsPerBatch, PartitionKind partition, HandOvers handOvers)
+    : cellSize_(cellSize), cellsPerBatch_(cellsPerBatch), handOvers_(handOvers),
+      partition_(makePartition(partition)) {
   if (threads < 1) throw std::invalid_argument("broad phase: at least one thread");
+  const bool async = handOvers == HandOvers::Asynchronous;
+  if (async && cellsPerBatch < 2)
+    throw std::invalid_argument("broad phase: asynchronous hand-overs need at least two cells per batch");
   for (std::size_t t = 0; t < threads; ++t) {
     auto w = std::make_unique<Worker>();
-    w->owned = makeBackend();
-    if (!w->owned) throw std::invalid_argument("broad phase: the backend factory gave no backend");
-    w->backend = w->owned.get();
+    if (async) {
+      w->async = std::make_unique<AsyncBackend>([&] {
+        auto device = makeBackend();
+        if (!device) throw std::invalid_argument("broad phase: the backend factory gave no backend");
+        return device;
+      });
+    } else {
+      w->owned = makeBackend();
+      if (!w->owned) throw std::invalid_argument("broad phase: the backend factory gave no backend");
+      w->backend = w->owned.get();
+    }
     workers_.push_back(std::move(w));
   }
-  capacity_ = workers_.front()->backend->capacity();
+  capacity_ = async ? workers_.front()->async->capacity() : workers_.front()->backend->capacity();
   if (threads > 1) pool_ = std::make_unique<Pool>(threads);
   configureWorkers();
 }
@@ -167,7 +201,7 @@ void BroadPhase::findKeyPairs(std::span<const KeyBox> keys, std::vector<Pair>& o
     identity_.resize(keys.size());
     std::iota(identity_.begin(), identity_.end(), 0u);
     workers_.front()->processCell(keys, identity_, keys, {}, nullptr, capacity_, true);
-    workers_.front()->flush();
+    workers_.front()->finish();
     times_.cellsSeconds = seconds(t0, Clock::now());
   } else if (!pool_) {
     streamCells(keys, bounds);
@@ -193,7 +227,7 @@ void BroadPhase::streamCells(std::span<const KeyBox> keys, const KeyBounds* boun
     for (const Cell& cell : partition_->cells())
       w.processCell(keys, partition_->items(cell), partition_->packed(cell), partition_->below(cell), &cell,
                     capacity_, lasting);
-    w.flush();  // the last, partly filled batch
+    w.finish();  // the last, partly filled batch
     times_.partitionSeconds = seconds(t0, built);
     times_.cellsSeconds = seconds(built, Clock::now());
     return;
@@ -206,7 +240,7 @@ void BroadPhase::streamCells(std::span<const KeyBox> keys, const KeyBounds* boun
     inCells += seconds(c0, Clock::now());
   }, bounds);
   const auto f0 = Clock::now();
-  w.flush();  // the last, partly filled batch
+  w.finish();  // the last, partly filled batch
   inCells += seconds(f0, Clock::now());
   times_.cellsSeconds = inCells;
   times_.partitionSeconds = seconds(t0, Clock::now()) - inCells;
@@ -239,23 +273,27 @@ void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys, const KeyBou
     tasks.wait();
     // Each worker's last, partly filled batch; no task runs any more, so
     // this thread may use every worker's backend.
-    for (auto& w : workers_) w->flush();
+    for (auto& w : workers_) w->finish();
   });
   times_.partitionSeconds = seconds(t0, built);
   times_.cellsSeconds = seconds(built, Clock::now());
 }
 
 void BroadPhase::startCells(Clock::time_point frameStart) {
-  for (auto& w : workers_) {
-    w->out.clear();
-    w->stats = {};
-    w->backendSeconds = 0;
-    w->frameStart = frameStart;
-    w->runs.clear();
-    w->pending.clear();  // left over only if a hand-over failed
-    w->pendingItems.clear();
-    w->pendingBoxes.clear();
-  }
+  for (auto& w : workers_) w->startFrame(frameStart);
+}
+
+void BroadPhase::Worker::startFrame(Clock::time_point start) {
+  out.clear();
+  stats = {};
+  backendSeconds = 0;
+  frameStart = start;
+  runs.clear();
+  // Left over only if a frame failed: the device must be done with it first.
+  if (inFlightResult.valid()) inFlightResult.wait();
+  filling.clear();
+  inFlight.clear();
+  inFlightResult = {};
 }
 
 void BroadPhase::finishCells(std::vector<Pair>& out) {
@@ -318,49 +356,95 @@ void BroadPhase::Worker::submit(std::span<const KeyBox> keys, std::span<const st
     cell.below = below;
   } else {
     cell.copied = true;
-    cell.begin = pendingItems.size();
+    cell.begin = filling.items.size();
     cell.count = items.size();
-    pendingItems.insert(pendingItems.end(), items.begin(), items.end());
+    filling.items.insert(filling.items.end(), items.begin(), items.end());
     if (packed.empty())
-      for (const std::uint32_t id : items) pendingBoxes.push_back(keys[id]);
+      for (const std::uint32_t id : items) filling.boxes.push_back(keys[id]);
     else
-      pendingBoxes.insert(pendingBoxes.end(), packed.begin(), packed.end());
+      filling.boxes.insert(filling.boxes.end(), packed.begin(), packed.end());
   }
-  pending.push_back(cell);
-  if (pending.size() >= cellsPerBatch) flush();
+  filling.cells.push_back(cell);
+  if (filling.cells.size() >= cellsPerBatch) flush();
 }
 
 void BroadPhase::Worker::flush() {
-  if (pending.empty()) return;
-  cellSpans.clear();
-  cellItems.clear();
-  for (const PendingCell& c : pending) {
-    cellSpans.push_back(c.copied ? std::span<const KeyBox>(pendingBoxes).subspan(c.begin, c.count) : c.boxes);
-    cellItems.push_back(c.copied ? std::span<const std::uint32_t>(pendingItems).subspan(c.begin, c.count) : c.items);
+  if (filling.cells.empty()) return;
+  filling.cellSpans.clear();
+  filling.cellItems.clear();
+  for (const PendingCell& c : filling.cells) {
+    filling.cellSpans.push_back(c.copied ? std::span<const KeyBox>(filling.boxes).subspan(c.begin, c.count) : c.boxes);
+    filling.cellItems.push_back(c.copied ? std::span<const std::uint32_t>(filling.items).subspan(c.begin, c.count)
+                                         : c.items);
   }
-  local.clear();
-  cellEnds.clear();
-  handOver(
-      [&](RunStats& runStats) {
-        backend->runBatch(cellSpans, local, cellEnds, runStats);
-        if (cellEnds.size() != pending.size() || (!cellEnds.empty() && cellEnds.back() != local.size()))
-          throw std::logic_error(fmt::format("broad phase: backend {} returned {} cell ends for a batch of {} cells",
-                                             backend->name(), cellEnds.size(), pending.size()));
-      },
-      [&] {
-        Pair* to = roomFor(local.size());
-        std::size_t from = 0;
-        for (std::size_t c = 0; c < pending.size(); ++c) {
-          const PendingCell& cell = pending[c];
-          to = keepPairs(std::span<const Pair>(local).subspan(from, cellEnds[c] - from), cellItems[c], cellSpans[c],
-                         cell.below, cell.hasRegion ? &cell.region : nullptr, cell.splitAt, cell.keep, to);
-          from = cellEnds[c];
-        }
-        keptUntil(to);
-      });
-  pending.clear();
-  pendingItems.clear();
-  pendingBoxes.clear();
+  if (!async) {
+    local.clear();
+    cellEnds.clear();
+    handOver([&](RunStats& runStats) { backend->runBatch(filling.cellSpans, local, cellEnds, runStats); },
+             [&] { decodeBatch(filling, local, cellEnds); });
+    filling.clear();
+    return;
+  }
+  // Asynchronous: this batch goes to the device, then the one before it is
+  // decoded while the device runs this one; this batch's buffers then wait
+  // in `inFlight` (swapping vectors keeps their storage, so the spans the
+  // device holds stay valid) and `filling` takes the decoded one's storage.
+  RunRecord record;
+  record.readySeconds = seconds(frameStart, Clock::now()) - backendSeconds;
+  std::future<BatchResult> result = async->submit(filling.cellSpans);
+  try {
+    collect();
+  } catch (...) {
+    result.wait();  // the device must be done with this batch's buffers before they are reused
+    filling.clear();
+    throw;
+  }
+  std::swap(filling, inFlight);
+  inFlightResult = std::move(result);
+  inFlightRecord = record;
+  filling.clear();
+}
+
+void BroadPhase::Worker::finish() {
+  flush();
+  if (async) collect();
+}
+
+void BroadPhase::Worker::collect() {
+  if (!inFlightResult.valid()) return;
+  const auto waitFrom = Clock::now();
+  BatchResult result;
+  try {
+    result = inFlightResult.get();  // rethrows the device's failure
+  } catch (...) {
+    inFlight.clear();
+    throw;
+  }
+  const auto got = Clock::now();
+  backendSeconds += seconds(waitFrom, got);  // the host waited for the device: not host work
+  RunRecord record = inFlightRecord;
+  record.stats = result.stats;
+  stats += result.stats;
+  decodeBatch(inFlight, result.pairs, result.cellEnds);
+  record.decodeSeconds = seconds(got, Clock::now());
+  runs.push_back(record);
+  inFlight.clear();
+}
+
+void BroadPhase::Worker::decodeBatch(const Batch& batch, std::span<const Pair> pairs,
+                                     std::span<const std::size_t> ends) {
+  if (ends.size() != batch.cells.size() || (!ends.empty() && ends.back() != pairs.size()))
+    throw std::logic_error(fmt::format("broad phase: backend {} returned {} cell ends for a batch of {} cells",
+                                       async ? async->name() : backend->name(), ends.size(), batch.cells.size()));
+  Pair* to = roomFor(pairs.size());
+  std::size_t from = 0;
+  for (std::size_t c = 0; c < batch.cells.size(); ++c) {
+    const PendingCell& cell = batch.cells[c];
+    to = keepPairs(pairs.subspan(from, ends[c] - from), batch.cellItems[c], batch.cellSpans[c], cell.below,
+                   cell.hasRegion ? &cell.region : nullptr, cell.splitAt, cell.keep, to);
+    from = ends[c];
+  }
+  keptUntil(to);
 }
 
 void BroadPhase::Worker::runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,

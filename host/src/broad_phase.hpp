@@ -27,6 +27,14 @@ struct HostTimes {
   double totalSeconds = 0;    // all of the above (conversion only when the input was floats)
 };
 
+/// How a worker hands its batches to the backend: waiting for each
+/// (Synchronous), or through an AsyncBackend that builds the worker's backend
+/// on a thread of its own, so that the next batch fills while the device
+/// runs the last one, whose pairs are decoded once the next has gone
+/// (Asynchronous; only with the factory constructor and cellsPerBatch > 1).
+/// The pairs, the counters and the hand-overs are the same either way.
+enum class HandOvers { Synchronous, Asynchronous };
+
 /// Finds every overlapping pair of a scene exactly once. Without a cell size
 /// the scene is one cell. A cell larger than the backend's capacity is
 /// covered in chunks of capacity/2 boxes: every two chunks run together, and
@@ -57,7 +65,8 @@ class BroadPhase {
              PartitionKind partition = PartitionKind::KdTree);
   /// `threads` workers (at least 1), each with its own backend.
   BroadPhase(const BackendFactory& makeBackend, std::optional<std::size_t> cellSize, std::size_t threads,
-             std::size_t cellsPerBatch = 1, PartitionKind partition = PartitionKind::KdTree);
+             std::size_t cellsPerBatch = 1, PartitionKind partition = PartitionKind::KdTree,
+             HandOvers handOvers = HandOvers::Synchronous);
   ~BroadPhase();
   BroadPhase(const BroadPhase&) = delete;
   BroadPhase& operator=(const BroadPhase&) = delete;
@@ -73,6 +82,7 @@ class BroadPhase {
   const Partition& partition() const { return *partition_; }
   std::size_t threads() const { return workers_.size(); }
   std::size_t cellsPerBatch() const { return cellsPerBatch_; }
+  HandOvers handOvers() const { return handOvers_; }
   /// The last call's hand-overs to the backend (batches, or single runs) in
   /// order, with the measured host time at which each was ready and its
   /// decoding took (for modelPipeline). With several threads, each worker's
@@ -97,6 +107,7 @@ class BroadPhase {
   std::unique_ptr<Pool> pool_;  // only with more than one worker
   std::optional<std::size_t> cellSize_;
   std::size_t cellsPerBatch_;
+  HandOvers handOvers_ = HandOvers::Synchronous;
   std::size_t capacity_;
   std::unique_ptr<Partition> partition_;
   std::vector<KeyBox> keys_;

@@ -4,9 +4,12 @@
 #include <optional>
 #include <random>
 #include <algorithm>
+#include <chrono>
 #include <set>
+#include <stdexcept>
 
 #include "all_pairs_kernel.hpp"
+#include "async_backend.hpp"
 #include "timeline.hpp"
 #include "backend.hpp"
 #include "broad_phase.hpp"
@@ -462,4 +465,134 @@ TEST(BroadPhase, BatchesWorkOnSeveralThreadsAndRejectZeroCellsPerBatch) {
     }
   ModelBackend m(2, 6, 5);
   EXPECT_THROW(BroadPhase(m, 16, 0), std::invalid_argument);
+}
+
+namespace {
+
+// A model that fails its `failAt`-th batch (counted from 1 over its life), as a device that hangs would.
+class FailingModel final : public Backend {
+ public:
+  explicit FailingModel(std::size_t failAt) : failAt_(failAt) {}
+  std::string name() const override { return "failing model"; }
+  std::size_t capacity() const override { return model_.capacity(); }
+  void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override {
+    model_.run(boxes, out, stats);
+  }
+  void runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
+                std::vector<std::size_t>& cellEnds, RunStats& stats) override {
+    if (++batches_ == failAt_) throw std::runtime_error("the device hung");
+    model_.runBatch(cells, out, cellEnds, stats);
+  }
+
+ private:
+  ModelBackend model_{2, 16, 5};
+  std::size_t failAt_;
+  std::size_t batches_ = 0;
+};
+
+std::vector<KeyBox> keysOf(const std::vector<Aabb>& boxes) {
+  std::vector<KeyBox> keys;
+  toKeys(boxes, keys);
+  return keys;
+}
+
+}  // namespace
+
+TEST(AsyncBackend, GivesEachHandOverWhatTheBackendGivesInSubmissionOrder) {
+  ModelBackend direct(2, 16, 5);
+  AsyncBackend async([] { return std::make_unique<ModelBackend>(2, 16, 5); });
+  EXPECT_EQ(async.name(), "model");
+  EXPECT_EQ(async.capacity(), 16u);
+  std::vector<std::vector<KeyBox>> scenes;
+  for (unsigned seed = 0; seed < 6; ++seed) scenes.push_back(keysOf(scatteredBoxes(40, seed, 0.0f, 30.0f, 1.0f, 4.0f)));
+  // Hand-overs of one to three cells of up to 16 boxes each, all submitted before any is waited for.
+  std::vector<std::vector<std::span<const KeyBox>>> handOvers;
+  for (std::size_t h = 0; h < scenes.size(); ++h) {
+    std::vector<std::span<const KeyBox>> cells;
+    for (std::size_t c = 0; c <= h % 3; ++c) cells.push_back(std::span<const KeyBox>(scenes[h]).subspan(8 * c, 16));
+    handOvers.push_back(cells);
+  }
+  std::vector<std::future<BatchResult>> results;
+  for (const auto& cells : handOvers) results.push_back(async.submit(cells));
+  for (std::size_t h = 0; h < handOvers.size(); ++h) {
+    // Polling: the result arrives without anyone waiting for it.
+    while (results[h].wait_for(std::chrono::seconds(0)) != std::future_status::ready) std::this_thread::yield();
+    const BatchResult got = results[h].get();
+    BatchResult expected;
+    direct.runBatch(handOvers[h], expected.pairs, expected.cellEnds, expected.stats);
+    EXPECT_EQ(got.pairs, expected.pairs) << "hand-over " << h;
+    EXPECT_EQ(got.cellEnds, expected.cellEnds) << "hand-over " << h;
+    EXPECT_EQ(got.stats.deviceCycles(), expected.stats.deviceCycles()) << "hand-over " << h;
+    EXPECT_EQ(got.stats.runs, expected.stats.runs) << "hand-over " << h;
+    EXPECT_GT(got.stats.runs, 0u);
+  }
+}
+
+TEST(AsyncBackend, PassesTheDevicesFailureToItsHandOverOnlyAndGoesOn) {
+  AsyncBackend async([] { return std::make_unique<ModelBackend>(2, 16, 5); });
+  const auto keys = keysOf(scatteredBoxes(20, 3, 0.0f, 10.0f, 1.0f, 4.0f));
+  const std::vector<std::span<const KeyBox>> tooLarge = {std::span<const KeyBox>(keys)};  // 20 > capacity 16
+  const std::vector<std::span<const KeyBox>> fits = {std::span<const KeyBox>(keys).first(16)};
+  auto bad = async.submit(tooLarge);
+  auto good = async.submit(fits);
+  EXPECT_THROW(bad.get(), std::length_error);
+  EXPECT_EQ(good.get().cellEnds.size(), 1u);
+}
+
+TEST(AsyncBackend, RethrowsAFailedDeviceConstructionFromItsOwnConstructor) {
+  EXPECT_THROW(AsyncBackend([]() -> std::unique_ptr<Backend> { throw std::runtime_error("no device"); }),
+               std::runtime_error);
+  EXPECT_THROW(AsyncBackend([] { return std::unique_ptr<Backend>(); }), std::invalid_argument);
+  EXPECT_THROW(BroadPhase([] { return std::make_unique<CpuBackend>(); }, 8, 1, 1, PartitionKind::KdTree,
+                          HandOvers::Asynchronous),
+               std::invalid_argument);  // one cell per batch: nothing to overlap
+}
+
+TEST(BroadPhase, AsynchronousHandOversGiveTheSynchronousPairsCountersAndRecords) {
+  for (const PartitionKind partition : {PartitionKind::KdTree, PartitionKind::UniformGrid})
+    for (std::size_t perBatch : {2u, 5u, 64u})
+      for (std::size_t n : {0u, 2u, 300u, 1000u})
+        for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 21)) {
+          const std::string label = name + " n " + std::to_string(n) + " per batch " + std::to_string(perBatch);
+          ModelBackend syncModel(2, 64, 5);
+          BroadPhase sync(syncModel, 16, perBatch, partition);
+          BroadPhase async([] { return std::make_unique<ModelBackend>(2, 64, 5); }, 16, 1, perBatch, partition,
+                           HandOvers::Asynchronous);
+          EXPECT_EQ(async.handOvers(), HandOvers::Asynchronous);
+          for (int frame = 0; frame < 2; ++frame) {  // the second frame reuses the in-flight buffers
+            std::vector<Pair> expected, pairs;
+            sync.findPairs(boxes, expected);
+            async.findPairs(boxes, pairs);
+            EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << label;
+            EXPECT_EQ(pairs, expected) << label;  // decoded in hand-over order, so in the same order
+            EXPECT_EQ(async.stats().deviceCycles(), sync.stats().deviceCycles()) << label;
+            EXPECT_EQ(async.stats().batches, sync.stats().batches) << label;
+            ASSERT_EQ(async.runs().size(), sync.runs().size()) << label;
+            for (std::size_t r = 0; r < sync.runs().size(); ++r)
+              EXPECT_EQ(async.runs()[r].stats.deviceCycles(), sync.runs()[r].stats.deviceCycles()) << label;
+          }
+        }
+}
+
+TEST(BroadPhase, AsynchronousHandOversWorkOnSeveralThreads) {
+  BroadPhase bp([] { return std::make_unique<ModelBackend>(2, 6, 5); }, 16, 2, 5, PartitionKind::KdTree,
+                HandOvers::Asynchronous);
+  for (std::size_t n : {2u, 300u, 1000u})
+    for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 23)) {
+      std::vector<Pair> pairs;
+      bp.findPairs(boxes, pairs);
+      EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << name;
+    }
+}
+
+TEST(BroadPhase, AsynchronousHandOversPassADeviceFailureOnAndRecover) {
+  const auto boxes = scatteredBoxes(400, 5, 0.0f, 20.0f, 0.5f, 2.0f);
+  for (std::size_t failAt : {1u, 2u, 3u}) {
+    BroadPhase bp([failAt] { return std::make_unique<FailingModel>(failAt); }, 8, 1, 4, PartitionKind::KdTree,
+                  HandOvers::Asynchronous);
+    std::vector<Pair> pairs;
+    EXPECT_THROW(bp.findPairs(boxes, pairs), std::runtime_error) << "failing hand-over " << failAt;
+    bp.findPairs(boxes, pairs);  // the device answers again: the next frame is whole
+    EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << "failing hand-over " << failAt;
+  }
 }

@@ -357,3 +357,21 @@ TEST(RtlBatch, RecoversAfterAHungBatchAndRunsTheNextExactly) {
   const BatchResult fromRtl = runBatchOn(rtl, b);
   EXPECT_EQ(fromRtl.pairs, runBatchOn(model, b).pairs);
 }
+
+TEST(RtlBatch, RunsOnItsOwnThreadBehindAnAsyncBackendWithTheSameResults) {
+  RtlBackend direct;
+  const auto boxes = scatteredBoxes(3 * BPACCEL_M + 40, 31, 0.0f, 20.0f, 0.5f, 3.0f);
+  std::vector<Pair> expected, pairs;
+  BroadPhase sync(direct, 2 * BPACCEL_M, 3);
+  sync.findPairs(boxes, expected);
+  {
+    // The Verilated model is built, run and destroyed on the hand-overs' own thread.
+    BroadPhase async([] { return std::make_unique<RtlBackend>(); }, 2 * BPACCEL_M, 1, 3, PartitionKind::KdTree,
+                     HandOvers::Asynchronous);
+    async.findPairs(boxes, pairs);
+    EXPECT_EQ(pairs, expected);
+    EXPECT_EQ(async.stats().deviceCycles(), sync.stats().deviceCycles());
+    EXPECT_EQ(async.stats().beatsReceived, sync.stats().beatsReceived);
+  }
+  EXPECT_EQ(sorted(pairs), bruteForce(boxes));
+}

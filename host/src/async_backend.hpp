@@ -1,0 +1,69 @@
+#pragma once
+// A backend on a thread of its own: hand-overs are submitted, and their
+// results collected later while the caller goes on.
+
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <functional>
+#include <future>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <stop_token>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "backend.hpp"
+
+namespace bpaccel {
+
+/// One hand-over's answer: what Backend::runBatch appends, for this hand-over alone.
+struct BatchResult {
+  std::vector<Pair> pairs;            // indices local to each cell, cells in order
+  std::vector<std::size_t> cellEnds;  // pairs.size() after each cell
+  RunStats stats;
+};
+
+/// A device on a thread of its own that runs hand-overs one after the other
+/// in the order they were submitted, as a card with a command queue would.
+/// submit() returns at once with a future to poll (wait_for with a zero
+/// timeout) or to wait on; an exception of the device (a hang, a hardware
+/// error, a cell over its capacity) comes out of that future's get(). The
+/// cells' boxes must stay valid until their future is ready.
+///
+/// The device is built, run and destroyed on that thread, from `makeDevice`:
+/// a Verilated model must be evaluated by the thread that constructed it
+/// (Verilator's rule; RtlBackend deadlocked at destruction otherwise). The
+/// constructor returns once the device exists, and rethrows its failure.
+/// Destruction finishes every hand-over submitted before it.
+class AsyncBackend {
+ public:
+  using DeviceFactory = std::function<std::unique_ptr<Backend>()>;
+  explicit AsyncBackend(const DeviceFactory& makeDevice);
+  ~AsyncBackend();
+  AsyncBackend(const AsyncBackend&) = delete;
+  AsyncBackend& operator=(const AsyncBackend&) = delete;
+
+  const std::string& name() const { return name_; }
+  std::size_t capacity() const { return capacity_; }
+  /// Queues one hand-over of `cells` (each at most capacity() boxes).
+  std::future<BatchResult> submit(std::span<const std::span<const KeyBox>> cells);
+
+ private:
+  struct Job {
+    std::vector<std::span<const KeyBox>> cells;
+    std::promise<BatchResult> result;
+  };
+  void serve(std::stop_token stop, Backend& device);
+
+  std::string name_;
+  std::size_t capacity_ = 0;
+  std::mutex mutex_;
+  std::condition_variable_any jobReady_;
+  std::deque<Job> jobs_;
+  std::jthread worker_;  // last: it starts once the members it uses exist, and stops first
+};
+
+}  // namespace bpaccel
