@@ -186,6 +186,8 @@ def table_only(args) -> int:
         if e.get("status") in ("ok", "does_not_fit") or report.is_file():
             e.pop("reason", None)
             e.update(load_report(report))
+            # The flow's own wall time: the sweep's entry may be an older run's.
+            e["wall_s"] = (e.get("data") or {}).get("runtime_s", {}).get("total") or e.get("wall_s")
     path.write_text(json.dumps(sweep, indent=2) + "\n")
     table = render(sweep)
     print(table)
