@@ -126,7 +126,6 @@ case class AccelParams(
     */
   val memoryRows: Int = if (arch == Arch.Stream) 2 << indexWidth else depth
 
-
   require(
     memoryStyle != MemoryStyle.Ecp5OutputRegister || memoryRows <= RegisteredReadMemory.maxEcp5Rows,
     s"memoryStyle ${MemoryStyle.Ecp5OutputRegister.name} builds each memory from DP16KD of at most " +

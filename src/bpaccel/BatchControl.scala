@@ -70,8 +70,8 @@ class BatchControl(p: AccelParams) extends Module {
   // Whether the tail offers a count, from a register (the queue held one at
   // the cycle's start) or the count flowing through: the queue's own valid
   // compares its pointers, and with overlapped loads every count taken
-  // clears the loader and the engine's owed shifts (stream m = 32's
-  // critical path at 597e8e6, 100.2 MHz: tail pointers -> take -> clear).
+  // clears the loader (stream m = 32's critical path at 597e8e6, 100.2 MHz:
+  // tail pointers -> take -> the loader's and the engine's clear).
   val tailHolds = RegInit(false.B)
   val tailValid = tailHolds || tailIn.valid
   assert(tailValid === tail.valid, "the tail queue's registered non-empty flag is wrong")

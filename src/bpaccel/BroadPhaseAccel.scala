@@ -83,7 +83,6 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   control.io.overflow := loader.io.overflow
 
   engine.io.write   := loader.io.write
-  engine.io.clear   := clear
   engine.io.prepare.valid := start.fire
   engine.io.prepare.bits  := start.bits
   engine.io.launch  := control.io.launch

@@ -96,7 +96,6 @@ class AccelInfo extends Bundle {
 /** The ports every architecture's engine offers the shared top level. */
 class EngineIO(p: AccelParams) extends Bundle {
   val write    = Flipped(Valid(new LoadWrite(p)))
-  val clear    = Input(Bool())                        // the loader restarts its numbering: a start, or a batch took a count
   val prepare  = Flipped(Valid(UInt(p.countWidth.W))) // a start was accepted (launched or not), with its n
   val launch   = Flipped(Valid(UInt(p.countWidth.W))) // a run of n >= 2 objects, all loaded
   val room     = Input(Bool())                        // the result queue has room for one more issue next cycle

@@ -51,7 +51,6 @@ class Loader(p: AccelParams) extends Module {
   })
   private val m = p.m
   val loaded   = RegInit(0.U(p.countWidth.W)) // boxes since the clear
-  val index    = RegInit(0.U(p.indexWidth.W)) // object index of the next box
   val lane     = RegInit(0.U(p.laneWidth.W))
   val row      = RegInit(0.U(p.rowWidth.W))
   val overflow = RegInit(false.B)
@@ -59,11 +58,12 @@ class Loader(p: AccelParams) extends Module {
   // block 0's lane reach the engine's per-lane registers through no compare
   // (seed m = 8's critical path ran from `loaded` through both to `loadRead`).
   val full     = RegInit(false.B) // loaded == capacity
-  val headLane = RegInit(1.U(p.headLanes.W)) // one-hot lane while index < headLanes, then 0
+  val headLane = RegInit(1.U(p.headLanes.W)) // one-hot lane while the next box is object k < headLanes, then 0
   assert(full === (loaded === p.capacity.U), "the loader's full flag does not match its count")
-  private val headLaneOfIndex = VecInit(Seq.tabulate(p.headLanes)(k => index === k.U)).asUInt
+  // Boxes are numbered in load order: the next box is object `loaded` (below the capacity while not full).
+  private val index = loaded(p.indexWidth - 1, 0)
+  private val headLaneOfIndex = VecInit(Seq.tabulate(p.headLanes)(k => loaded === k.U)).asUInt
   assert(full || headLane === headLaneOfIndex, "the loader's head lane does not match its index")
-  assert(full || index === loaded, "the loader's index does not match its count")
 
   io.write.valid      := io.load.valid && !full
   io.write.bits.index := index
@@ -80,7 +80,6 @@ class Loader(p: AccelParams) extends Module {
     }.otherwise {
       loaded := loaded + 1.U
       full   := loaded === (p.capacity - 1).U
-      index    := index + 1.U
       headLane := (headLane << 1)(p.headLanes - 1, 0)
       if (m == 1) row := row + 1.U
       else {
@@ -96,7 +95,6 @@ class Loader(p: AccelParams) extends Module {
     row      := 0.U
     overflow := false.B
     full     := false.B
-    index    := 0.U
     headLane := 1.U
   }
 }

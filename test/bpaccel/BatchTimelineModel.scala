@@ -23,7 +23,7 @@ object BatchTimelineModel {
     require(sizes.nonEmpty, "a batch has at least one cell")
     var take    = 0L  // the head takes this cell's count
     var lastEnd = -1L // the cycle the cell before ended
-    var run          = 0L
+    var run     = 0L
     for (n <- sizes) {
       val taken    = take + n // the cycle of the last box taken (or of the count)
       val start    = math.max(taken + 1, lastEnd + 1)
