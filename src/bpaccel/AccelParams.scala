@@ -113,10 +113,11 @@ case class AccelParams(
     */
   val overlapsLoads: Boolean = arch == Arch.Stream
 
-  /** Objects the loader marks by a one-hot lane as they arrive: block 0's A
-    * objects 0 .. m-1, and for the stream object m too (its head registers).
+  /** Objects 0 .. headObjects-1 of a run start it from registers: the seed's
+    * block-0 A objects (m), the stream's head registers (m + 1: block 0's A
+    * objects and its window).
     */
-  val headLanes: Int = if (arch == Arch.Stream) m + 1 else m
+  val headObjects: Int = if (arch == Arch.Stream) m + 1 else m
 
   /** Bits of an object index 0 .. capacity-1. */
   val indexWidth: Int = log2Ceil(capacity).max(1)

@@ -85,6 +85,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   engine.io.write   := loader.io.write
   engine.io.prepare.valid := start.fire
   engine.io.prepare.bits  := start.bits
+  engine.io.headPad       := loader.io.headPad
   engine.io.launch  := control.io.launch
   // Credits: result-queue entries neither occupied nor claimed by a cycle in
   // flight. They are kept in a register, because the check computed from the

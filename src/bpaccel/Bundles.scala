@@ -97,6 +97,7 @@ class AccelInfo extends Bundle {
 class EngineIO(p: AccelParams) extends Bundle {
   val write    = Flipped(Valid(new LoadWrite(p)))
   val prepare  = Flipped(Valid(UInt(p.countWidth.W))) // a start was accepted (launched or not), with its n
+  val headPad  = Input(UInt(log2Ceil(p.headObjects + 1).W)) // with a start: the loader's head pad (Loader)
   val launch   = Flipped(Valid(UInt(p.countWidth.W))) // a run of n >= 2 objects, all loaded
   val room     = Input(Bool())                        // the result queue has room for one more issue next cycle
   val activity = Output(new EngineActivity(p))
@@ -117,6 +118,18 @@ object Engine {
   /** Lanes per partial hit count: an 8-bit popcount is a few LUT4 levels. */
   val HitCountGroup = 8
   private def groupSizes(m: Int): Seq[Int] = (0 until m by HitCountGroup).map(g => (m - g).min(HitCountGroup))
+
+  /** `x` moved down by `by` * `unit` bits, zeros in at the top, as wide as `x`:
+    * one stage of fixed shifts per bit of `by` (firrtl2's formal backend
+    * rejects a dynamic shift by an amount wider than the value, as at m = 1).
+    */
+  def shiftDown(x: UInt, by: UInt, unit: Int = 1): UInt = {
+    val w = x.getWidth
+    by.asBools.zipWithIndex.foldLeft(x) { case (v, (bit, b)) =>
+      val step = unit << b
+      Mux(bit, if (step >= w) 0.U(w.W) else (v >> step).pad(w), v)
+    }
+  }
 
   /** One count per group of lanes, each as wide as its group needs. */
   def hitCounts(m: Int): MixedVec[UInt] = MixedVec(groupSizes(m).map(size => UInt(log2Ceil(size + 1).W)))
@@ -152,10 +165,16 @@ abstract class Engine(val p: AccelParams) extends Module {
     * popcount off the path from the mask to the hit counter (stream m = 64's
     * critical path, 90.8 MHz: the 64-bit popcount in one cycle, 13 LUT
     * levels). Only for an engine whose compares are registered before the AND.
+    *
+    * `shiftDown`: lanes by which the mask is moved towards lane 0, so that
+    * its bit k is the pair (iBase + k, jBase + k) when the engine's lanes
+    * hold the run's objects from a lane other than 0 (the stream's short
+    * runs). The lanes shifted out must not hit; any and counts come from the
+    * unshifted hits, off the shifter's path.
     */
-  protected def hitRegisters(hits: UInt): HitSummary = {
+  protected def hitRegisters(hits: UInt, shiftDown: UInt = 0.U): HitSummary = {
     val summary = Wire(new HitSummary(p.m))
-    summary.mask   := hits
+    summary.mask   := Engine.shiftDown(hits, shiftDown)
     summary.any    := hits.orR
     for ((count, lanes) <- summary.counts.zip(hits.asBools.grouped(Engine.HitCountGroup))) count := PopCount(lanes)
     RegNext(summary)

@@ -37,6 +37,8 @@ object Fault {
   case object BatchLoadsInSeries extends Fault("the batch loads its next cell only after the last one ended")
   /** The stream copies the head registers two cycles late, after a batch's next cell may have written them. */
   case object HeadCopiedLate extends Fault("the stream's start copies the head registers two cycles late")
+  /** A short stream run's hit mask is not moved down by the lanes its objects start up the head chain. */
+  case object ShortRunMaskNotAligned extends Fault("a short stream run's hit mask is not moved down to lane 0")
 
   val all: Seq[Fault] = Seq(
     CreditOneTooMany,
@@ -52,6 +54,7 @@ object Fault {
     LookaheadIgnoresRoom,
     CellCounterSkipsShortCells,
     BatchLoadsInSeries,
-    HeadCopiedLate
+    HeadCopiedLate,
+    ShortRunMaskNotAligned
   )
 }

@@ -12,12 +12,10 @@ class LoadWrite(p: AccelParams) extends Bundle {
   val lane  = UInt(p.laneWidth.W)
   val row   = UInt(p.rowWidth.W)
   val box   = new Aabb(p.keyWidth)
-  /** One-hot: bit k set when this is object k < p.headLanes: block 0's A
-    * objects, and for the stream object m too (its head registers hold
-    * objects 0 .. m, which start a run's A block and B window). */
-  val headLane = UInt(p.headLanes.W)
-  /** One-hot: bit k set when this is object k < m, one of block 0's A objects. */
-  def firstBlockLane: UInt = headLane(p.m - 1, 0)
+  /** One-hot: bit k set when this is object k < m, one of block 0's A objects (the seed's A registers). */
+  val firstBlockLane = UInt(p.m.W)
+  /** This is object k < p.headObjects: for the stream, one its head registers keep. */
+  val head = Bool()
 }
 
 /** A batch cell's box count, with what the front end tests of it decided as
@@ -47,6 +45,9 @@ class Loader(p: AccelParams) extends Module {
     val clear    = Input(Bool())
     val write    = Valid(new LoadWrite(p))
     val loaded   = Output(UInt(p.countWidth.W))
+    // Of the stream's head registers, how many the boxes loaded leave empty:
+    // headObjects - min(loaded, headObjects), a register.
+    val headPad  = Output(UInt(log2Ceil(p.headObjects + 1).W))
     val overflow = Output(Bool()) // a box arrived when `capacity` were loaded; held until clear
   })
   private val m = p.m
@@ -58,20 +59,26 @@ class Loader(p: AccelParams) extends Module {
   // block 0's lane reach the engine's per-lane registers through no compare
   // (seed m = 8's critical path ran from `loaded` through both to `loadRead`).
   val full     = RegInit(false.B) // loaded == capacity
-  val headLane = RegInit(1.U(p.headLanes.W)) // one-hot lane while the next box is object k < headLanes, then 0
+  val firstBlockLane = RegInit(1.U(m.W)) // one-hot lane while the next box is object k < m, then 0
+  val head     = RegInit(true.B)         // the next box is object k < headObjects
+  val headPad  = RegInit(p.headObjects.U(log2Ceil(p.headObjects + 1).W)) // headObjects - min(loaded, headObjects)
   assert(full === (loaded === p.capacity.U), "the loader's full flag does not match its count")
   // Boxes are numbered in load order: the next box is object `loaded` (below the capacity while not full).
   private val index = loaded(p.indexWidth - 1, 0)
-  private val headLaneOfIndex = VecInit(Seq.tabulate(p.headLanes)(k => loaded === k.U)).asUInt
-  assert(full || headLane === headLaneOfIndex, "the loader's head lane does not match its index")
+  private val firstBlockLaneOfIndex = VecInit(Seq.tabulate(m)(k => loaded === k.U)).asUInt
+  assert(full || firstBlockLane === firstBlockLaneOfIndex, "the loader's block-0 lane does not match its index")
+  assert(headPad === Mux(loaded < p.headObjects.U, p.headObjects.U - loaded, 0.U) && head === (headPad =/= 0.U),
+    "the loader's head flag or pad does not match its count")
 
   io.write.valid      := io.load.valid && !full
   io.write.bits.index := index
   io.write.bits.lane  := lane
   io.write.bits.row   := row
   io.write.bits.box   := io.load.bits
-  io.write.bits.headLane := headLane
+  io.write.bits.firstBlockLane := firstBlockLane
+  io.write.bits.head  := head
   io.loaded           := loaded
+  io.headPad          := headPad
   io.overflow         := overflow
 
   when(io.load.valid) {
@@ -80,7 +87,11 @@ class Loader(p: AccelParams) extends Module {
     }.otherwise {
       loaded := loaded + 1.U
       full   := loaded === (p.capacity - 1).U
-      headLane := (headLane << 1)(p.headLanes - 1, 0)
+      firstBlockLane := (firstBlockLane << 1)(m - 1, 0)
+      when(head) {
+        headPad := headPad - 1.U
+        head    := headPad =/= 1.U
+      }
       if (m == 1) row := row + 1.U
       else {
         val lastLane = lane === (m - 1).U
@@ -95,6 +106,8 @@ class Loader(p: AccelParams) extends Module {
     row      := 0.U
     overflow := false.B
     full     := false.B
-    headLane := 1.U
+    firstBlockLane := 1.U
+    head     := true.B
+    headPad  := p.headObjects.U
   }
 }

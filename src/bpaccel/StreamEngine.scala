@@ -18,14 +18,24 @@ import chisel3.util._
   * the window's top lane in cycle k of the current block; `aNext` captures
   * them there and is copied into `a` at the block change.
   *
-  * Objects 0 .. m are kept, as they are loaded, in head registers of their
-  * own (`headRegs`, written by lane, enables only). The cycle after a start
-  * copies them at once: objects 1 .. m into the window, 0 .. m-1 into
-  * `aNext`. So a run needs no window shifts of its own before it issues,
-  * and a batch's next cell loads all its boxes, these included, while the
-  * current cell runs. Only the window and `aNext` have a multiplexer in
-  * front of them (neighbour or head register, top lane or head register);
-  * `a` loads from `aNext`.
+  * Objects 0 .. m are kept, as they are loaded, in m + 1 head registers of
+  * their own (`headRegs`): a shift chain beside the window, entered at the
+  * top, so the loaded box goes to one register and every other wire is
+  * local (written by lane, the box went to all m + 1 and congested stream
+  * m = 32's routing). The cycle after a start copies them at once: lane
+  * k + 1 into window lane k, lane k into `aNext` lane k. So a run needs no
+  * window shifts of its own before it issues, and a batch's next cell loads
+  * all its boxes, these included, while the current cell runs. Only the
+  * window and `aNext` have a multiplexer in front of them (neighbour or
+  * head register, top lane or head register); `a` loads from `aNext`.
+  *
+  * A run of L < m + 1 loaded boxes leaves its objects d = m + 1 - L lanes
+  * up the chain (object j in lane j + d; d is the loader's head pad, read
+  * with the start), and so in the window and the A block: a short run's
+  * lanes k < d are masked, and its lane k compares objects k - d and
+  * k - d + s. The AND stage moves the hit mask down by d lanes, so the
+  * beats are the schedule's exactly. Runs of more than one block have
+  * n >= m + 2 objects, so d = 0 for them.
   *
   * Startup after the start: the first readLatency reads travel to the
   * window's entry. Pipeline: comparator register, AND register.
@@ -187,16 +197,26 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val startingSoon    = io.prepare.valid || startingCarry
   val unlaunchedStart = RegNext(io.prepare.valid && !io.launch.valid, false.B)
 
-  // ---- objects 0 .. m: kept in head registers as they are loaded ----
-  // Written by the loader's one-hot lane (registered beside the box), so
-  // each register has an enable and no multiplexer. A batch writes its next
-  // cell's head here while the current cell runs: the start copied these
-  // registers in the cycle after it, and the next cell's boxes come later.
-  val headRegs = Reg(Vec(m + 1, new Entry))
-  val headWrites = Seq.tabulate(m + 1)(k => loadedBox.valid && loadedBox.bits.headLane(k))
-  for (k <- 0 to m) when(headWrites(k)) {
-    headRegs(k).box := loadedBox.bits.box.asUInt
-    headRegs(k).tag := tagOf(loadedBox.bits.index)
+  // ---- objects 0 .. m: kept in a chain of head registers as they are loaded ----
+  // Each head object enters the top register and moves every register
+  // below it down one lane, so after L of them object j sits in lane
+  // j + m + 1 - min(L, m + 1). The shift's enable is registered once per
+  // lane beside the box (like the window's), from the loader's head flag. A
+  // batch writes its next cell's head here while the current cell runs: the
+  // start copied these registers in the cycle after it, and the next cell's
+  // boxes come later.
+  val headRegs  = Reg(Vec(m + 1, new Entry))
+  val headWrite = loadedBox.valid && loadedBox.bits.head
+  val headShift = Seq.tabulate(m + 1) { k =>
+    val copy = RegNext(io.write.valid && io.write.bits.head, false.B).suggestName(s"headShift_replica$k")
+    assert(copy === headWrite, "a copy of the head chain's shift enable is wrong")
+    copy
+  }
+  for (k <- 0 to m) when(headShift(k)) {
+    if (k == m) {
+      headRegs(k).box := loadedBox.bits.box.asUInt
+      headRegs(k).tag := tagOf(loadedBox.bits.index)
+    } else headRegs(k) := headRegs(k + 1)
   }
   // The cycle after every accepted start copies the head registers into the
   // window and aNext (an unlaunched start's copy is harmless: the next start
@@ -210,7 +230,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // so its first box is written two cycles later at the earliest).
   val copyPending = RegInit(false.B)
   when(io.prepare.valid) { copyPending := true.B }.elsewhen(copying) { copyPending := false.B }
-  assert(!(copyPending && headWrites.reduce(_ || _) && !io.prepare.valid),
+  assert(!(copyPending && headWrite && !io.prepare.valid),
     "a head register was written before the start's copy of it")
 
   // ---- the window: lane k holds object s+k ----
@@ -261,6 +281,10 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val s         = Reg(UInt(p.countWidth.W))
   val left      = Reg(UInt(p.countWidth.W)) // n-1-s: cycles after this one in the block
   val blockLeft = Reg(UInt(p.countWidth.W)) // n-2-base
+  // The run's lanes start `headOffset` lanes up (d above; 0 unless n < m + 2),
+  // so lane k holds object s + k - d, which exists while k <= left + d = laneTop.
+  val headOffset = Reg(UInt(log2Ceil(p.headObjects + 1).W))
+  val laneTop    = Reg(UInt(p.countWidth.W))
   // The block-end test, computed one cycle ahead so that no comparison sits
   // between the issue and the enables of the A registers.
   val blockEnd     = Reg(Bool()) // left == 0
@@ -283,6 +307,8 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val blockLeftIsM       = Reg(Bool()) // blockLeft == m
   val blockLeftAtLeast2m = Reg(Bool()) // blockLeft >= 2m
   when(starting || issuing) {
+    assert(laneTop === left + headOffset && (headOffset === 0.U || !hasNextBlock),
+      "the lanes' offset does not match the run")
     assert(leftIsOne === (left === 1.U) && blockLeftIsM === (blockLeft === m.U) &&
       blockLeftAtLeast2m === (blockLeft >= (2 * m).U), "the block-end flags do not match their counters")
   }
@@ -304,6 +330,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     when(!blockEnd) {
       s        := s + 1.U
       left     := left - 1.U
+      laneTop  := laneTop - 1.U
       leftIsOne := left === 2.U
       blockEndCarry := leftIsOne
       captureNext := (capture << 1)(m - 1, 0)
@@ -311,6 +338,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       base         := base + m.U
       s            := base + (m + 1).U
       left         := blockLeft - m.U
+      laneTop      := blockLeft - m.U // headOffset = 0: this run has n >= m + 2
       blockLeft    := blockLeft - m.U
       leftIsOne          := blockLeft === (m + 1).U
       blockLeftIsM       := blockLeft === (2 * m).U
@@ -334,6 +362,8 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     s         := 1.U
     left      := count - 2.U
     blockLeft := count - 2.U
+    headOffset := io.headPad
+    laneTop    := count - 2.U + io.headPad
     leftIsOne          := count === 3.U
     blockLeftIsM       := count === (m + 2).U
     blockLeftAtLeast2m := count >= (2 * m + 2).U
@@ -356,22 +386,27 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   class Meta extends Bundle {
     val iBase    = UInt(p.indexWidth.W)
     val jBase    = UInt(p.indexWidth.W)
-    val laneMask = UInt(m.W)
+    val laneMask = UInt(m.W) // by lane of the engine (the run's lane k - headOffset)
+    val shift    = UInt(log2Ceil(p.headObjects + 1).W) // headOffset
     val probeI   = Vec(m, UInt(p.indexWidth.W)) // only with the debug port
     val probeJ   = Vec(m, UInt(p.indexWidth.W))
   }
   val meta = Wire(new Meta)
   meta.iBase    := base
   meta.jBase    := s
+  meta.shift    := headOffset
   meta.laneMask := VecInit(Seq.tabulate(m)(k =>
-    // Lane k holds object s+k, which exists while n - s > k, i.e. left >= k:
-    // from `left` directly, not from n - s (that subtraction in front of the
-    // compares was stream m = 32's critical path, 105.5 MHz).
-    if (p.has(Fault.LaneMaskOneTooWide)) (if (k == 0) true.B else left >= (k - 1).U) else left >= k.U)).asUInt
+    // Lane k holds object s+k-d, which exists while n - s > k - d, i.e.
+    // laneTop >= k: from a register directly, not from n - s (that
+    // subtraction in front of the compares was stream m = 32's critical
+    // path, 105.5 MHz). Lanes below d hold no object of the run.
+    headOffset <= k.U &&
+      (if (p.has(Fault.LaneMaskOneTooWide)) laneTop +& 1.U >= k.U else laneTop >= k.U))).asUInt
   if (p.debugPort) {
-    // The objects each lane really holds, from the tags that travelled with the data.
-    meta.probeI := VecInit(a.map(_.tag))
-    meta.probeJ := VecInit(window.map(_.tag))
+    // The objects each lane really holds, from the tags that travelled with
+    // the data, moved down by d lanes as the hit mask is.
+    meta.probeI := alignDown(a.map(_.tag), headOffset)
+    meta.probeJ := alignDown(window.map(_.tag), headOffset)
   } else {
     meta.probeI := DontCare
     meta.probeJ := DontCare
@@ -383,7 +418,10 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   compare.io.b := VecInit(window.map(boxOf))
   val compared = RegNext(compare.io.compares)
   val atCompare = Pipe(issue, meta)
-  val hits = hitRegisters(ComparatorArray.hits(compared) & atCompare.bits.laneMask)
+  val hits = hitRegisters(
+    ComparatorArray.hits(compared) & atCompare.bits.laneMask,
+    if (p.has(Fault.ShortRunMaskNotAligned)) 0.U else atCompare.bits.shift
+  )
   val atAnd     = Pipe(atCompare)
   require(p.pipelineLatency == 2)
 
@@ -392,6 +430,13 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   io.activity.stalled  := issuing && !advance
   io.activity.inFlight := atCompare.valid.asUInt +& atAnd.valid.asUInt
   io.activity.retired  := atAnd.valid
+
+  /** Lane k + by of `lanes` in lane k (the debug port's probes only). */
+  private def alignDown(lanes: Seq[UInt], by: UInt): Vec[UInt] = {
+    val w       = lanes.head.getWidth
+    val shifted = Engine.shiftDown(Cat(lanes.reverse), by, unit = w)
+    VecInit(Seq.tabulate(m)(k => shifted(k * w + w - 1, k * w)))
+  }
 
   /** One register per lane holding `next` of the last cycle, checked to equal
     * `now`: each copy drives one lane's 192 clock enables, where one net
@@ -412,5 +457,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   val outValid =
     if (p.has(Fault.RepeatLastBeat)) atAnd.valid || (RegNext(atAnd.valid, false.B) && !atAnd.valid) else atAnd.valid
-  emit(outValid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, atAnd.bits.probeI, atAnd.bits.probeJ, hits)
+  emit(outValid, atAnd.bits.iBase, atAnd.bits.jBase, Engine.shiftDown(atAnd.bits.laneMask, atAnd.bits.shift), atAnd.bits.probeI,
+    atAnd.bits.probeJ, hits)
 }

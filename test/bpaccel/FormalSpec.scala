@@ -157,7 +157,8 @@ class FormalSpec extends AnyFlatSpec with ChiselScalatestTester with Formal with
     (Fault.DoneBeforeQueueEmpty, Property.Done, 1, 2, 16),
     (Fault.LaneMaskOneTooWide, Property.Lanes, 2, 3, 16),
     (Fault.SkipSecondBlockAtMPlus2, Property.Pairs, 1, 3, 16),
-    (Fault.HeadCopyOffByOne, Property.Lanes, 2, 3, 12)
+    (Fault.HeadCopyOffByOne, Property.Lanes, 2, 3, 12),
+    (Fault.ShortRunMaskNotAligned, Property.Pairs, 2, 3, 12)
   )
   private val longMutants: Seq[(Fault, Property, Int, Int, Int)] = Seq(
     (Fault.CreditOneTooMany, Property.ExactlyOnce, 1, 4, 24)
