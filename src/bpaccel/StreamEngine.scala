@@ -33,8 +33,8 @@ import chisel3.util._
   * up the chain (object j in lane j + d; d is the loader's head pad, read
   * with the start), and so in the window and the A block: a short run's
   * lanes k < d are masked, and its lane k compares objects k - d and
-  * k - d + s. The AND stage moves the hit mask down by d lanes, so the
-  * beats are the schedule's exactly. Runs of more than one block have
+  * k - d + s. The hit mask leaves the AND stage's register moved down
+  * by d lanes (Engine.emit), so the beats are the schedule's exactly. Runs of more than one block have
   * n >= m + 2 objects, so d = 0 for them.
   *
   * Startup after the start: the first readLatency reads travel to the
@@ -418,10 +418,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   compare.io.b := VecInit(window.map(boxOf))
   val compared = RegNext(compare.io.compares)
   val atCompare = Pipe(issue, meta)
-  val hits = hitRegisters(
-    ComparatorArray.hits(compared) & atCompare.bits.laneMask,
-    if (p.has(Fault.ShortRunMaskNotAligned)) 0.U else atCompare.bits.shift
-  )
+  val hits = hitRegisters(ComparatorArray.hits(compared) & atCompare.bits.laneMask)
   val atAnd     = Pipe(atCompare)
   require(p.pipelineLatency == 2)
 
@@ -457,6 +454,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   val outValid =
     if (p.has(Fault.RepeatLastBeat)) atAnd.valid || (RegNext(atAnd.valid, false.B) && !atAnd.valid) else atAnd.valid
-  emit(outValid, atAnd.bits.iBase, atAnd.bits.jBase, Engine.shiftDown(atAnd.bits.laneMask, atAnd.bits.shift), atAnd.bits.probeI,
-    atAnd.bits.probeJ, hits)
+  emit(outValid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, atAnd.bits.probeI, atAnd.bits.probeJ, hits,
+    shiftDown = atAnd.bits.shift)
 }
