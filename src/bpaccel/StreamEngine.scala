@@ -15,8 +15,9 @@ import chisel3.util._
   * next block's first objects, so blocks follow each other without a bubble.
   *
   * A blocks sit in registers (`a`). The next block's A objects base+m+k pass
-  * the window's top lane in cycle k of the current block; `aNext` captures
-  * them there and is copied into `a` at the block change.
+  * the window's top lane in cycle k of the current block; `aNext`, a shift
+  * chain entered at the top, takes each there (so object base+m+k ends in
+  * lane k after m shifts) and is copied into `a` at the block change.
   *
   * Objects 0 .. m are kept, as they are loaded, in m + 1 head registers of
   * their own (`headRegs`): a shift chain beside the window, entered at the
@@ -256,23 +257,27 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val a     = Reg(Vec(m, new Entry))
   val aNext = Reg(Vec(m, new Entry))
   // Block 0's A objects come from the head registers at the copy; later
-  // blocks': cycle k of a block finds object base+m+k in the top lane.
-  val capture     = Reg(UInt(m.W)) // one-hot: lane of aNext to fill at this issue
+  // blocks': cycle k of a block finds object base+m+k in the top lane, and
+  // the first m issues of a block shift it into aNext's top lane, moving the
+  // ones before it down. (Written by lane, the top lane's 192 bits went to
+  // all m lanes of aNext, across the window: with the head registers'
+  // broadcast, stream m = 64 did not route.)
+  val capture     = RegInit(0.U(m.W)) // one-hot: which of the block's first m issues this is, 0 after them
   val captureNext = WireDefault(capture)
   capture := captureNext
+  val capturing     = RegInit(false.B) // capture =/= 0, as a register
+  val capturingNext = WireDefault(capturing)
+  capturing := capturingNext
+  assert(capturing === capture.orR, "the capture flag does not match its count")
   // Each lane's enable is a register computed a cycle ahead, as the window's
   // and the A block's are: `issuing` reached lane k's 192 enables through
   // issue && capture(k) (stream m = 64's critical path, 83.7 MHz, 11.0 ns of wire).
-  val aNextLoad = laneEnables(
-    "aNextLoad",
-    next = Seq.tabulate(m)(k => issueNext && captureNext(k)),
-    now = Seq.tabulate(m)(k => issue && capture(k))
-  )
+  val aNextShift = replicatedEnable("aNextShift", next = issueNext && capturingNext, now = issue && capturing)
   for (k <- 0 until m) {
     when(headCopy(k)) {
       aNext(k) := headRegs(k)
-    }.elsewhen(aNextLoad(k)) {
-      aNext(k) := window(m - 1)
+    }.elsewhen(aNextShift(k)) {
+      aNext(k) := (if (k == m - 1) window(m - 1) else aNext(k + 1))
     }
   }
 
@@ -334,6 +339,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       leftIsOne := left === 2.U
       blockEndCarry := leftIsOne
       captureNext := (capture << 1)(m - 1, 0)
+      capturingNext := capturing && !capture(m - 1)
     }.elsewhen(hasNextBlock) {
       base         := base + m.U
       s            := base + (m + 1).U
@@ -346,6 +352,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       blockEndCarry     := blockLeftIsM
       hasNextBlockCarry := blockLeftAtLeast2m
       captureNext  := 1.U
+      capturingNext := true.B
     }.otherwise {
       issuingNext := false.B
     }
@@ -370,6 +377,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     blockEndNext     := count === 2.U
     hasNextBlockNext := count >= (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 3 else 2)).U
     captureNext := 1.U
+    capturingNext := true.B
     rBase      := 0.U
     rBlockLeft := count - 2.U
     // R[m] is block 0's object m+1 when it exists; otherwise no later block
