@@ -27,16 +27,17 @@ import chisel3.util._
   * k + 1 into window lane k, lane k into `aNext` lane k. So a run needs no
   * window shifts of its own before it issues, and a batch's next cell loads
   * all its boxes, these included, while the current cell runs. Only the
-  * window and `aNext` have a multiplexer in front of them (neighbour or
-  * head register, top lane or head register); `a` loads from `aNext`.
+  * window and `aNext` have a multiplexer in front of them (the lane above,
+  * or the entry / the window's top lane at the top, else the head
+  * register); `a` loads from `aNext`.
   *
   * A run of L < m + 1 loaded boxes leaves its objects d = m + 1 - L lanes
   * up the chain (object j in lane j + d; d is the loader's head pad, read
   * with the start), and so in the window and the A block: a short run's
   * lanes k < d are masked, and its lane k compares objects k - d and
   * k - d + s. The hit mask leaves the AND stage's register moved down
-  * by d lanes (Engine.emit), so the beats are the schedule's exactly. Runs of more than one block have
-  * n >= m + 2 objects, so d = 0 for them.
+  * by d lanes (Engine.emit), so the beats are the schedule's exactly.
+  * Runs of more than one block have n >= m + 2 objects, so d = 0 for them.
   *
   * Startup after the start: the first readLatency reads travel to the
   * window's entry. Pipeline: comparator register, AND register.
@@ -208,11 +209,13 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // boxes come later.
   val headRegs  = Reg(Vec(m + 1, new Entry))
   val headWrite = loadedBox.valid && loadedBox.bits.head
-  val headShift = Seq.tabulate(m + 1) { k =>
-    val copy = RegNext(io.write.valid && io.write.bits.head, false.B).suggestName(s"headShift_replica$k")
-    assert(copy === headWrite, "a copy of the head chain's shift enable is wrong")
-    copy
-  }
+  val headShift = replicatedEnable(
+    "headShift",
+    next = io.write.valid && io.write.bits.head,
+    now = headWrite,
+    copies = m + 1,
+    unless = false.B // exact: no start is involved
+  )
   for (k <- 0 to m) when(headShift(k)) {
     if (k == m) {
       headRegs(k).box := loadedBox.bits.box.asUInt
@@ -443,20 +446,25 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     VecInit(Seq.tabulate(m)(k => shifted(k * w + w - 1, k * w)))
   }
 
-  /** One register per lane holding `next` of the last cycle, checked to equal
-    * `now`: each copy drives one lane's 192 clock enables, where one net
-    * drove all 192m (stream m = 64's critical path: 12.4 ns of routing to
-    * about 12,000 flip-flops). Synthesis merges identical registers unless
-    * told otherwise; the FPGA flow keeps the copies by name (docs/fpga.md).
+  /** One register per lane (`copies` of them) holding `next` of the last
+    * cycle, checked to equal `now` except in a cycle where `unless` holds
+    * (by default the cycle after a start that did not launch, whose
+    * look-ahead took it for a launch): each copy drives one lane's 192
+    * clock enables, where one net drove all 192m (stream m = 64's critical
+    * path: 12.4 ns of routing to about 12,000 flip-flops). Synthesis merges
+    * identical registers unless told otherwise; the FPGA flow keeps the
+    * copies by name (docs/fpga.md).
     */
-  private def replicatedEnable(name: String, next: Bool, now: Bool): Seq[Bool] =
-    laneEnables(name, Seq.fill(m)(next), Seq.fill(m)(now))
-
-  /** [[replicatedEnable]] with an enable of its own for each lane. */
-  private def laneEnables(name: String, next: Seq[Bool], now: Seq[Bool]): Seq[Bool] =
-    next.zip(now).zipWithIndex.map { case ((nextK, nowK), k) =>
-      val copy = RegNext(nextK, false.B).suggestName(s"${name}_replica$k")
-      assert(copy === nowK || unlaunchedStart, s"the look-ahead of $name is wrong")
+  private def replicatedEnable(
+    name: String,
+    next: Bool,
+    now: Bool,
+    copies: Int = m,
+    unless: Bool = unlaunchedStart
+  ): Seq[Bool] =
+    Seq.tabulate(copies) { k =>
+      val copy = RegNext(next, false.B).suggestName(s"${name}_replica$k")
+      assert(copy === now || unless, s"the look-ahead of $name is wrong")
       copy
     }
 
