@@ -212,33 +212,38 @@ void BroadPhase::findKeyPairs(std::span<const KeyBox> keys, std::vector<Pair>& o
   times_.totalSeconds = times_.partitionSeconds + times_.cellsSeconds;
 }
 
-// Each cell goes to the backend as soon as the partition has made it (with
-// the tree, the first run is ready long before the tree is finished). A
-// partition whose cells are all final only at the end (the grid) is built
-// first and its cells then gone through here: no call through the sink and
-// no clock read per cell.
+// Each cell goes to the backend as soon as the partition has made it: the
+// tree hands each leaf to a sink while it goes on (the first run is ready
+// long before the tree is finished); other partitions tell when a prefix
+// of their cells is final (the grid: slab by slab), and those cells are
+// gone through here, with no call through a sink and no clock read per cell.
 void BroadPhase::streamCells(std::span<const KeyBox> keys, const KeyBounds* bounds) {
   const auto t0 = Clock::now();
   Worker& w = *workers_.front();
-  if (!partition_->streamsCells()) {
-    partition_->build(keys, *cellSize_, {}, bounds);
-    const auto built = Clock::now();
-    const bool lasting = partition_->cellsOutliveBuild();
-    for (const Cell& cell : partition_->cells())
-      w.processCell(keys, partition_->items(cell), partition_->packed(cell), partition_->below(cell), &cell,
-                    capacity_, lasting);
-    w.finish();  // the last, partly filled batch
-    times_.partitionSeconds = seconds(t0, built);
-    times_.cellsSeconds = seconds(built, Clock::now());
-    return;
-  }
   double inCells = 0;
-  partition_->build(keys, *cellSize_, [&](const Cell& leaf, std::span<const std::uint32_t> items,
-                                          std::span<const KeyBox> packed) {
-    const auto c0 = Clock::now();
-    w.processCell(keys, items, packed, {}, &leaf, capacity_, partition_->cellsOutliveBuild());
-    inCells += seconds(c0, Clock::now());
-  }, bounds);
+  if (partition_->streamsCells()) {
+    partition_->build(keys, *cellSize_, [&](const Cell& leaf, std::span<const std::uint32_t> items,
+                                            std::span<const KeyBox> packed) {
+      const auto c0 = Clock::now();
+      w.processCell(keys, items, packed, {}, &leaf, capacity_, partition_->cellsOutliveBuild());
+      inCells += seconds(c0, Clock::now());
+    }, bounds);
+  } else {
+    std::size_t done = 0;
+    const auto processUpTo = [&](std::size_t finalCells) {
+      const auto c0 = Clock::now();
+      const auto& cells = partition_->cells();
+      const bool lasting = partition_->cellsOutliveBuild();
+      for (; done < finalCells; ++done) {
+        const Cell& cell = cells[done];
+        w.processCell(keys, partition_->items(cell), partition_->packed(cell), partition_->below(cell), &cell,
+                      capacity_, lasting);
+      }
+      inCells += seconds(c0, Clock::now());
+    };
+    // One reference captured: the sink fits std::function's own storage (no allocation a frame).
+    partition_->buildInSteps(keys, *cellSize_, [&processUpTo](std::size_t k) { processUpTo(k); }, bounds);
+  }
   const auto f0 = Clock::now();
   w.finish();  // the last, partly filled batch
   inCells += seconds(f0, Clock::now());

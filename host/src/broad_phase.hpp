@@ -43,7 +43,7 @@ enum class HandOvers { Synchronous, Asynchronous };
 /// The scene is partitioned into cells by a k-d tree (the default) or a
 /// uniform grid (PartitionKind). The cells go to the backend as the
 /// partition makes them: the tree hands each over while it goes on, the
-/// grid all of them after its two passes.
+/// grid slab by slab once its items are placed (Partition::buildInSteps).
 /// With several threads, the calling thread builds the partition and the cells are
 /// shared out among workers as tasks, each worker with a backend of its own
 /// from the factory (backends keep scratch state and are not shared between

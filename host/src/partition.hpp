@@ -37,6 +37,9 @@ struct Cell {
 /// All three are valid during the call only.
 using CellSink = std::function<void(const Cell&, std::span<const std::uint32_t> items, std::span<const KeyBox> packed)>;
 
+/// Called with k each time cells()[0, k) are final (buildInSteps).
+using StepSink = std::function<void(std::size_t finalCells)>;
+
 /// Built anew every frame from the frame's boxes; storage is kept between builds.
 class Partition {
  public:
@@ -62,10 +65,19 @@ class Partition {
   /// of copying); otherwise they are valid during the call only.
   virtual bool cellsOutliveBuild() const { return false; }
   /// Whether build hands each cell to its sink while it goes on (the tree:
-  /// the first cell is ready long before the last). Otherwise every cell is
-  /// final only at the end, and a caller may build without a sink and go
-  /// through cells() itself (no call through the sink per cell).
+  /// the first cell is ready long before the last). Otherwise a caller
+  /// builds in steps (buildInSteps) and goes through cells() itself.
   virtual bool streamsCells() const { return false; }
+  /// Builds as build() without a sink does, telling `onStep` each time a
+  /// prefix of cells() is final: their items(), packed() and below() stay
+  /// valid until the next build. For a partition that does not stream its
+  /// cells: the caller goes through them itself, with no call through a
+  /// sink and no clock read per cell. By default one step at the end.
+  virtual void buildInSteps(std::span<const KeyBox> boxes, std::size_t cellSize, const StepSink& onStep,
+                            const KeyBounds* bounds = nullptr) {
+    build(boxes, cellSize, {}, bounds);
+    if (onStep) onStep(cells().size());
+  }
   /// A cell of the last build, its boxes packed in item order, when the
   /// partition keeps them until the next build; else empty.
   virtual std::span<const KeyBox> packed(const Cell&) const { return {}; }

@@ -438,6 +438,31 @@ void UniformGrid::forEachOtherCell(const Range& r, F&& f) const {
 
 void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell,
                         const KeyBounds* bounds) {
+  if (!place(boxes, cellSize, bounds)) {
+    fallback_.build(boxes, cellSize, onCell);
+    return;
+  }
+  gather(boxes, 0, cells_.size());
+  if (!onCell) return;
+  for (const Cell& cell : cells_)
+    onCell(cell, {items_.data() + cell.begin, cell.count}, {packed_.data() + cell.begin, cell.count});
+}
+
+void UniformGrid::buildInSteps(std::span<const KeyBox> boxes, std::size_t cellSize, const StepSink& onStep,
+                               const KeyBounds* bounds) {
+  if (!place(boxes, cellSize, bounds)) {
+    fallback_.build(boxes, cellSize, {});
+    if (onStep) onStep(fallback_.cells().size());
+    return;
+  }
+  const std::size_t perSlab = std::size_t{axes_[0].cells()} * axes_[1].cells();
+  for (std::size_t to = perSlab; to <= cells_.size(); to += perSlab) {
+    gather(boxes, to - perSlab, to);
+    if (onStep) onStep(to);
+  }
+}
+
+bool UniformGrid::place(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds* bounds) {
   checkObjectCount(boxes.size());
   if (cellSize < 1) cellSize = 1;
   cells_.clear();
@@ -446,10 +471,7 @@ void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, con
   const std::size_t cellCount = std::size_t{nx} * ny * nz;
   offsets_.assign(cellCount, 0);
   fellBack_ = !countBoxes(boxes);
-  if (fellBack_) {
-    fallback_.build(boxes, cellSize, onCell);
-    return;
-  }
+  if (fellBack_) return false;
   // Prefix sum: each cell's count becomes its first item.
   std::uint64_t total = 0;
   cells_.reserve(cellCount);
@@ -473,7 +495,6 @@ void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, con
   std::uint64_t* const cursor = offsets_.data();
   std::uint32_t* const items = items_.data();
   std::uint8_t* const below = itemBelow_.data();
-  KeyBox* const packed = packed_.data();
   const std::uint32_t* const firsts = firstCell_.data();
   // A box in its first cell lies below it on no axis: those bits are cleared
   // in one sweep, not written one by one beside the items.
@@ -484,11 +505,17 @@ void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, con
     items[at] = e.id;
     below[at] = e.below;
   }
-  // The boxes gathered in cell order: writing them in order is cheaper than
-  // scattering them with their indices (one cache line filled at a time).
-  for (std::uint64_t t = 0; t < total; ++t) packed[t] = boxes[items[t]];
-  if (!onCell) return;
-  for (const Cell& cell : cells_) onCell(cell, {items + cell.begin, cell.count}, {packed + cell.begin, cell.count});
+  return true;
+}
+
+// Writing the boxes in order is cheaper than scattering them with their
+// indices (one cache line filled at a time).
+void UniformGrid::gather(std::span<const KeyBox> boxes, std::size_t from, std::size_t to) {
+  if (from == to) return;
+  const std::uint32_t* const items = items_.data();
+  KeyBox* const packed = packed_.data();
+  const std::uint64_t end = cells_[to - 1].begin + cells_[to - 1].count;
+  for (std::uint64_t t = cells_[from].begin; t < end; ++t) packed[t] = boxes[items[t]];
 }
 
 }  // namespace bpaccel

@@ -172,11 +172,67 @@ TEST(UniformGrid, OwnsPairFromBelowBitsAgreesWithTheReferencePointInTheRegion) {
   }
 }
 
-TEST(UniformGrid, HandsItsCellsOverAtTheEndWhileTheTreeStreamsThem) {
-  EXPECT_FALSE(UniformGrid().streamsCells()) << "BroadPhase goes through the grid's cells after the build";
+TEST(UniformGrid, SaysEachSlabsCellsAreFinalOnlyOnceTheyAreAsTheBuildAtOnceMakesThem) {
+  EXPECT_FALSE(UniformGrid().streamsCells()) << "BroadPhase builds the grid in steps and goes through its cells";
   EXPECT_TRUE(KdTree().streamsCells()) << "the tree's first leaf goes to the device before the tree is done";
   EXPECT_TRUE(KdTree().below(Cell{}).empty());
   EXPECT_TRUE(KdTree().packed(Cell{}).empty());
+  // What a cell held when a step (or the sink) said it was final must be
+  // what it holds after a build at once: items, below() bits and boxes, in
+  // the same order.
+  struct Held {
+    std::vector<std::uint32_t> items;
+    std::vector<std::uint8_t> below;
+    std::vector<KeyBox> packed;
+    bool operator==(const Held& o) const {
+      if (items != o.items || below != o.below || packed.size() != o.packed.size()) return false;
+      for (std::size_t t = 0; t < packed.size(); ++t)
+        if (packed[t].min != o.packed[t].min || packed[t].max != o.packed[t].max) return false;
+      return true;
+    }
+  };
+  const auto held = [](const UniformGrid& grid, const Cell& c, std::span<const std::uint32_t> items,
+                       std::span<const KeyBox> packed) {
+    const auto below = grid.below(c);
+    return Held{{items.begin(), items.end()}, {below.begin(), below.end()}, {packed.begin(), packed.end()}};
+  };
+  std::size_t slabbed = 0;
+  for (const auto& [name, boxes] : adversarialScenes(400, 9)) {
+    std::vector<KeyBox> keys;
+    toKeys(boxes, keys);
+    for (std::size_t cell : {1u, 4u, 16u, 64u}) {
+      const std::string label = name + " cell " + std::to_string(cell);
+      UniformGrid streamed, stepped, whole;
+      std::vector<Held> handed, final;
+      streamed.build(keys, cell, [&](const Cell& c, auto items, auto packed) {
+        handed.push_back(held(streamed, c, items, packed));
+      });
+      std::size_t steps = 0;
+      stepped.buildInSteps(keys, cell, [&](std::size_t finalCells) {
+        ++steps;
+        EXPECT_GT(finalCells, final.size()) << label << ": each step finishes cells";
+        while (final.size() < finalCells) {
+          const Cell& c = stepped.cells().at(final.size());
+          final.push_back(held(stepped, c, stepped.items(c), stepped.packed(c)));
+        }
+      });
+      whole.build(keys, cell, {});
+      ASSERT_EQ(streamed.fellBack(), whole.fellBack()) << label;
+      if (whole.fellBack()) continue;
+      EXPECT_EQ(steps, whole.resolution()[2]) << label << ": one step a slab";
+      slabbed += whole.resolution()[2] > 1;
+      ASSERT_EQ(handed.size(), whole.cells().size()) << label << ": every cell once";
+      ASSERT_EQ(final.size(), whole.cells().size()) << label << ": the last step finishes every cell";
+      for (std::size_t c = 0; c < handed.size(); ++c) {
+        const Cell& w = whole.cells()[c];
+        const Held expected = held(whole, w, whole.items(w), whole.packed(w));
+        EXPECT_TRUE(handed[c] == expected) << label << " cell " << c << ": the sink's cell differs";
+        EXPECT_TRUE(final[c] == expected) << label << " cell " << c << ": a step said final too early";
+        EXPECT_EQ(streamed.cells()[c].begin, w.begin) << label;
+      }
+    }
+  }
+  EXPECT_GE(slabbed, 10u) << "many scenes should have several slabs";
 }
 
 TEST(UniformGrid, CellsDoNotDependOnWhichLoopComputedABox) {
