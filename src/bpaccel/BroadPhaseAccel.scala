@@ -83,10 +83,6 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   control.io.overflow := loader.io.overflow
 
   engine.io.write   := loader.io.write
-  engine.io.writeOffered := io.load.valid && !loader.io.full
-  engine.io.writeReady   := io.load.ready
-  assert(engine.io.write.valid === (engine.io.writeOffered && engine.io.writeReady),
-    "the write's factors do not make its valid")
   engine.io.prepare.valid := start.fire
   engine.io.prepare.bits  := start.bits
   engine.io.headPad       := loader.io.headPad

@@ -96,11 +96,6 @@ class AccelInfo extends Bundle {
 /** The ports every architecture's engine offers the shared top level. */
 class EngineIO(p: AccelParams) extends Bundle {
   val write    = Flipped(Valid(new LoadWrite(p)))
-  // The write's valid as its two factors (write.valid = both): a box offered
-  // with room in the loader, and the load port's ready, which the host's
-  // start and cells decide. An engine's look-ahead registers them apart.
-  val writeOffered = Input(Bool())
-  val writeReady   = Input(Bool())
   val prepare  = Flipped(Valid(UInt(p.countWidth.W))) // a start was accepted (launched or not), with its n
   val headPad  = Input(UInt(log2Ceil(p.headObjects + 1).W)) // with a start: the loader's head pad (Loader)
   val launch   = Flipped(Valid(UInt(p.countWidth.W))) // a run of n >= 2 objects, all loaded

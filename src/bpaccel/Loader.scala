@@ -49,7 +49,6 @@ class Loader(p: AccelParams) extends Module {
     // headObjects - min(loaded, headObjects), a register.
     val headPad  = Output(UInt(log2Ceil(p.headObjects + 1).W))
     val overflow = Output(Bool()) // a box arrived when `capacity` were loaded; held until clear
-    val full     = Output(Bool()) // `capacity` boxes loaded: a box now is refused (a register)
   })
   private val m = p.m
   val loaded   = RegInit(0.U(p.countWidth.W)) // boxes since the clear
@@ -81,7 +80,6 @@ class Loader(p: AccelParams) extends Module {
   io.loaded           := loaded
   io.headPad          := headPad
   io.overflow         := overflow
-  io.full             := full
 
   when(io.load.valid) {
     when(full) {

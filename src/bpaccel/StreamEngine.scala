@@ -209,12 +209,9 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // boxes come later.
   val headRegs  = Reg(Vec(m + 1, new Entry))
   val headWrite = loadedBox.valid && loadedBox.bits.head
-  // Its look-ahead's two factors are copied apart: through the load port's
-  // ready, the host's start reached the copies (stream m = 64's critical
-  // path, 78.8 MHz: 5 LUT levels, 11.0 ns of routing).
   val headShift = replicatedEnable(
     "headShift",
-    next = Seq(io.writeOffered && io.write.bits.head, io.writeReady),
+    next = io.write.valid && io.write.bits.head,
     now = headWrite,
     copies = m + 1,
     unless = false.B // exact: no start is involved
@@ -231,7 +228,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val copyAfter = if (p.has(Fault.HeadCopiedLate)) 3 else 1 // cycles after the start
   val copyNext  = ShiftRegister(io.prepare.valid, copyAfter - 1, false.B, true.B)
   val copying   = RegNext(copyNext, false.B)
-  val headCopy  = replicatedEnable("headCopy", next = Seq(copyNext), now = copying)
+  val headCopy  = replicatedEnable("headCopy", next = copyNext, now = copying)
   // headCopiedBeforeWritten: no head box of the next cell is written before
   // the copy of this one (the front end takes the next count at the start,
   // so its first box is written two cycles later at the earliest).
@@ -245,7 +242,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val entry  = readHead.io.deq.bits
   val windowShift = replicatedEnable(
     "windowShift",
-    next = Seq(issuingNext && (io.room || p.has(Fault.LookaheadIgnoresRoom).B)),
+    next = issuingNext && (io.room || p.has(Fault.LookaheadIgnoresRoom).B),
     now = issue
   )
   // The window takes objects 1 .. m from the head registers at the copy.
@@ -278,7 +275,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // Each lane's enable is a register computed a cycle ahead, as the window's
   // and the A block's are: `issuing` reached lane k's 192 enables through
   // issue && capture(k) (stream m = 64's critical path, 83.7 MHz, 11.0 ns of wire).
-  val aNextShift = replicatedEnable("aNextShift", next = Seq(issueNext && capturingNext), now = issue && capturing)
+  val aNextShift = replicatedEnable("aNextShift", next = issueNext && capturingNext, now = issue && capturing)
   for (k <- 0 until m) {
     when(headCopy(k)) {
       aNext(k) := headRegs(k)
@@ -326,7 +323,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // The A block is copied from aNext through the startup and at each block change.
   val aLoad = replicatedEnable(
     "aLoad",
-    next = Seq(startingSoon || (issueNext && blockEndCarry && hasNextBlockCarry)),
+    next = startingSoon || (issueNext && blockEndCarry && hasNextBlockCarry),
     now = starting || (issue && blockEnd && hasNextBlock)
   )
   for (k <- 0 until m) when(aLoad(k)) { a(k) := aNext(k) }
@@ -450,9 +447,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   }
 
   /** One register per lane (`copies` of them) holding `next` of the last
-    * cycle (the AND of its factors, each copied apart, so that one factor's
-    * logic does not lie in front of another's long wires), checked to equal
-    * `now` except in a cycle where `unless` holds
+    * cycle, checked to equal `now` except in a cycle where `unless` holds
     * (by default the cycle after a start that did not launch, whose
     * look-ahead took it for a launch): each copy drives one lane's 192
     * clock enables, where one net drove all 192m (stream m = 64's critical
@@ -462,21 +457,18 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     */
   private def replicatedEnable(
     name: String,
-    next: Seq[Bool],
+    next: Bool,
     now: Bool,
     copies: Int = m,
     unless: Bool = unlaunchedStart
   ): Seq[Bool] = {
-    // The reset enters once, at the source of the first factor: reset on
-    // each copy sent the wrapper's reset register to every lane (stream
-    // m = 64's critical path, 60.2 MHz, 15.6 ns of routing). The same
-    // function as a reset copy's: 0 in the cycle after a reset cycle, `next`
-    // of the last one otherwise.
-    val factors = (next.head && !reset.asBool) +: next.tail
+    // The reset enters once, at the source: reset on each copy sent the
+    // wrapper's reset register to every lane (stream m = 64's critical path,
+    // 60.2 MHz, 15.6 ns of routing). The same function as a reset copy's:
+    // each holds 0 in the cycle after a reset cycle, `next` of the last one otherwise.
+    val gated = next && !reset.asBool
     Seq.tabulate(copies) { k =>
-      val copy = factors.zipWithIndex.map { case (factor, i) =>
-        RegNext(factor).suggestName(if (i == 0) s"${name}_replica$k" else s"${name}${i}_replica$k")
-      }.reduce(_ && _)
+      val copy = RegNext(gated).suggestName(s"${name}_replica$k")
       assert(copy === now || unless, s"the look-ahead of $name is wrong")
       copy
     }
