@@ -202,10 +202,10 @@ TEST(UniformGrid, SaysEachSlabsCellsAreFinalOnlyOnceTheyAreAsTheBuildAtOnceMakes
     toKeys(boxes, keys);
     for (std::size_t cell : {1u, 4u, 16u, 64u}) {
       const std::string label = name + " cell " + std::to_string(cell);
-      UniformGrid streamed, stepped, whole;
+      UniformGrid withSink, stepped, whole;
       std::vector<Held> handed, final;
-      streamed.build(keys, cell, [&](const Cell& c, auto items, auto packed) {
-        handed.push_back(held(streamed, c, items, packed));
+      withSink.build(keys, cell, [&](const Cell& c, auto items, auto packed) {
+        handed.push_back(held(withSink, c, items, packed));
       });
       std::size_t steps = 0;
       stepped.buildInSteps(keys, cell, [&](std::size_t finalCells) {
@@ -217,7 +217,7 @@ TEST(UniformGrid, SaysEachSlabsCellsAreFinalOnlyOnceTheyAreAsTheBuildAtOnceMakes
         }
       });
       whole.build(keys, cell, {});
-      ASSERT_EQ(streamed.fellBack(), whole.fellBack()) << label;
+      ASSERT_EQ(withSink.fellBack(), whole.fellBack()) << label;
       if (whole.fellBack()) continue;
       EXPECT_EQ(steps, whole.resolution()[2]) << label << ": one step a slab";
       slabbed += whole.resolution()[2] > 1;
@@ -228,7 +228,7 @@ TEST(UniformGrid, SaysEachSlabsCellsAreFinalOnlyOnceTheyAreAsTheBuildAtOnceMakes
         const Held expected = held(whole, w, whole.items(w), whole.packed(w));
         EXPECT_TRUE(handed[c] == expected) << label << " cell " << c << ": the sink's cell differs";
         EXPECT_TRUE(final[c] == expected) << label << " cell " << c << ": a step said final too early";
-        EXPECT_EQ(streamed.cells()[c].begin, w.begin) << label;
+        EXPECT_EQ(withSink.cells()[c].begin, w.begin) << label;
       }
     }
   }
