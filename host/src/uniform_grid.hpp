@@ -31,7 +31,7 @@ namespace bpaccel {
 /// slab that its cells are final: a device starts on the first slab's cells
 /// while the host gathers the others, at no cost in work. (Scattering by
 /// slabs too was measured: its sort of the entries by slab cost the bench's
-/// frame about 20 us of host work, more than it moved the first cells forward.)
+/// frame about 20 µs of host work, more than it moved the first cells forward.)
 ///
 /// Resolution: the planes are evenly spaced in float space (world units)
 /// between the scene's lowest box minimum and highest box maximum, since keys
