@@ -64,11 +64,12 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   val clear = start.fire || (if (p.overlapsLoads) batch.io.take.valid else batch.io.begin)
 
   // A start or a batch's first count in the same cycle wins, so a box is never loaded into the next run by accident.
-  io.load.ready := Mux(
-    batch.io.active,
-    batch.io.loadReady,
-    !control.io.status.busy && !io.start.valid && !io.cells.valid
-  )
+  // `offered` is the same without that term, for the engine's look-aheads:
+  // the host's start and count reached the head chain's enable copies
+  // through the load port's ready (stream m = 64's critical path, 78.8 MHz).
+  val loadOpen = Mux(batch.io.active, batch.io.loadReady, !control.io.status.busy)
+  io.load.ready := loadOpen && (batch.io.active || !io.start.valid && !io.cells.valid)
+  loader.io.offered    := io.load.valid && loadOpen
   loader.io.load.valid := io.load.fire
   loader.io.load.bits  := io.load.bits
   loader.io.clear      := clear
@@ -83,6 +84,8 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   control.io.overflow := loader.io.overflow
 
   engine.io.write   := loader.io.write
+  engine.io.writeOffered := loader.io.writeOffered
+  engine.io.loadClear    := clear
   engine.io.prepare.valid := start.fire
   engine.io.prepare.bits  := start.bits
   engine.io.headPad       := loader.io.headPad

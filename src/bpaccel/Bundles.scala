@@ -96,6 +96,8 @@ class AccelInfo extends Bundle {
 /** The ports every architecture's engine offers the shared top level. */
 class EngineIO(p: AccelParams) extends Bundle {
   val write    = Flipped(Valid(new LoadWrite(p)))
+  val writeOffered = Input(Bool()) // write.valid, unless this cycle clears the loader (Loader)
+  val loadClear    = Input(Bool()) // a start or a batch count restarts the numbering of loaded boxes
   val prepare  = Flipped(Valid(UInt(p.countWidth.W))) // a start was accepted (launched or not), with its n
   val headPad  = Input(UInt(log2Ceil(p.headObjects + 1).W)) // with a start: the loader's head pad (Loader)
   val launch   = Flipped(Valid(UInt(p.countWidth.W))) // a run of n >= 2 objects, all loaded

@@ -35,8 +35,8 @@ object Fault {
   case object CellCounterSkipsShortCells extends Fault("the batch's cell counter skips cells of 0 or 1 objects")
   /** The batch front end takes the next count only when a cell ends, as before loads overlapped runs. */
   case object BatchLoadsInSeries extends Fault("the batch loads its next cell only after the last one ended")
-  /** The stream copies the head registers two cycles late, after a batch's next cell may have written them. */
-  case object HeadCopiedLate extends Fault("the stream's start copies the head registers two cycles late")
+  /** The stream's window and A block miss the head registers' copy in the cycle after a start, so a batch's next cell may write them first. */
+  case object HeadCopiedLate extends Fault("the stream's window misses the head registers' copy in the cycle after a start")
   /** A short stream run's hit mask is not moved down by the lanes its objects start up the head chain. */
   case object ShortRunMaskNotAligned extends Fault("a short stream run's hit mask is not moved down to lane 0")
 

@@ -42,8 +42,14 @@ object CellCount {
 class Loader(p: AccelParams) extends Module {
   val io = IO(new Bundle {
     val load     = Flipped(Valid(new Aabb(p.keyWidth))) // an accepted box
+    // A box is offered that the load port takes unless a start or a batch's
+    // first count is accepted in this cycle (which then clears the loader).
+    val offered  = Input(Bool())
     val clear    = Input(Bool())
     val write    = Valid(new LoadWrite(p))
+    // io.write.valid, unless a clear refused the box: free of the host's start
+    // and count, for look-aheads whose error in a clearing cycle is harmless.
+    val writeOffered = Output(Bool())
     val loaded   = Output(UInt(p.countWidth.W))
     // Of the stream's head registers, how many the boxes loaded leave empty:
     // headObjects - min(loaded, headObjects), a register.
@@ -71,6 +77,9 @@ class Loader(p: AccelParams) extends Module {
     "the loader's head flag or pad does not match its count")
 
   io.write.valid      := io.load.valid && !full
+  io.writeOffered     := io.offered && !full
+  assert(!io.load.valid || io.offered, "a box was accepted that was not offered")
+  assert(io.writeOffered === io.write.valid || io.clear, "a box offered to the loader was refused without a clear")
   io.write.bits.index := index
   io.write.bits.lane  := lane
   io.write.bits.row   := row

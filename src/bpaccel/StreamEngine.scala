@@ -109,8 +109,12 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val readQueue = Module(
     new Queue(new Entry, p.readLatency + 1, flow = true, hasFlush = true)
   )
-  val readHead = Module(new Queue(new Entry, 1, pipe = true, hasFlush = true))
-  readHead.io.enq <> readQueue.io.deq
+  // The head register, a one-entry pipe stage behind the queue. Written out,
+  // not a one-entry Queue: that queue's one-row memory of tags let z3 answer
+  // a counterexample with a model ChiselTest's formal backend cannot read
+  // back ("(lambda ((x!1 Bool)) x!1)"), and synthesis makes it this register anyway.
+  val headValid = RegInit(false.B)
+  val headEntry = Reg(new Entry)
   val readsInFlight = Wire(UInt(log2Ceil(p.readLatency + 1).W))
   // Queue slots not yet taken or claimed by a read in flight, kept as a
   // register: comparing the queue's count plus the reads in flight with its
@@ -174,30 +178,30 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   readsInFlight := PopCount(readStages.map(_.valid))
   readQueue.io.enq.valid := readStages.last.valid
   readQueue.io.enq.bits  := readStages.last.bits
-  readHead.io.deq.ready  := issue
+  readQueue.io.deq.ready := !headValid || issue
+  when(readQueue.io.deq.fire) { headEntry := readQueue.io.deq.bits }
   readQueue.io.flush.get := io.launch.valid // drop what the last run read ahead
-  readHead.io.flush.get  := io.launch.valid
-  assert(!issue || readHead.io.deq.valid, "the stream's reader fell behind the schedule")
+  headValid := !io.launch.valid && (readQueue.io.deq.fire || (headValid && !issue))
+  assert(!issue || headValid, "the stream's reader fell behind the schedule")
   assert(!readQueue.io.enq.valid || readQueue.io.enq.ready, "the stream's read queue overflowed")
   // A run is launched only after its boxes were loaded, at least two cycles
   // after the last run's last read left its pipeline, so the flush drops
   // every read of that run and all credits come back.
   assert(!io.launch.valid || readsInFlight === 0.U, "a read of the last run was in flight at a launch")
   assert(
-    readQueue.io.count +& readHead.io.count +& readsInFlight +& readCredits === readDepth.U || io.launch.valid,
+    readQueue.io.count +& headValid.asUInt +& readsInFlight +& readCredits === readDepth.U || io.launch.valid,
     "the stream's read credits do not match the queue"
   )
 
   starting := io.launch.valid || startingCarry
   issuing  := issuingNext
-  // The look-ahead of the enables takes every accepted start (`io.prepare`)
-  // for a launch, so that the start's decoded error checks stay out of it
-  // (stream m = 32's critical path ran from them into the window's enable
-  // copies). A start that does not launch therefore copies the head
-  // registers and the A block once, in the next cycle: harmless, as no run
-  // uses them then and the next start copies both again.
-  val startingSoon    = io.prepare.valid || startingCarry
-  val unlaunchedStart = RegNext(io.prepare.valid && !io.launch.valid, false.B)
+  // No look-ahead of the per-lane enables reads this cycle's start or the
+  // load port's handshake with it: the host's start register reached them
+  // through the start's acceptance and the load port's ready (stream m = 64's
+  // critical path at 92b097e, 78.8 MHz: host start -> load ready -> a head
+  // chain enable copy; taking it off that look-ahead alone moved it to the
+  // next one, d26d030). Each look-ahead below says why it needs no start.
+  val active = starting || issuing
 
   // ---- objects 0 .. m: kept in a chain of head registers as they are loaded ----
   // Each head object enters the top register and moves every register
@@ -209,12 +213,17 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // boxes come later.
   val headRegs  = Reg(Vec(m + 1, new Entry))
   val headWrite = loadedBox.valid && loadedBox.bits.head
+  // Its look-ahead takes a box offered for a write even in a cycle whose
+  // start or batch count refuses it (`writeOffered`): that spurious shift
+  // comes the cycle after the clear, when the copy below reads the chain's
+  // old values, and only moves boxes of the numbering the clear ended (the
+  // loader checks that only a clear refuses an offered box).
   val headShift = replicatedEnable(
     "headShift",
-    next = io.write.valid && io.write.bits.head,
+    next = io.writeOffered && io.write.bits.head,
     now = headWrite,
     copies = m + 1,
-    unless = false.B // exact: no start is involved
+    unless = RegNext(io.loadClear, false.B)
   )
   for (k <- 0 to m) when(headShift(k)) {
     if (k == m) {
@@ -222,13 +231,19 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       headRegs(k).tag := tagOf(loadedBox.bits.index)
     } else headRegs(k) := headRegs(k + 1)
   }
-  // The cycle after every accepted start copies the head registers into the
-  // window and aNext (an unlaunched start's copy is harmless: the next start
-  // copies again). Per lane, computed a cycle ahead like the other enables.
-  val copyAfter = if (p.has(Fault.HeadCopiedLate)) 3 else 1 // cycles after the start
-  val copyNext  = ShiftRegister(io.prepare.valid, copyAfter - 1, false.B, true.B)
-  val copying   = RegNext(copyNext, false.B)
-  val headCopy  = replicatedEnable("headCopy", next = copyNext, now = copying)
+  // The window and aNext follow the head registers in every cycle after one
+  // with no run active (starting or issuing), so in the cycle after a start
+  // too, when they copy the run's objects 0 .. m for good: its last head box
+  // was written in the start's cycle at the latest. Following needs no
+  // start in the look-ahead (copying in the cycle after each start did: the
+  // host's start reached these enable copies); what is copied while idle is
+  // never compared. A batch's next cell writes the head registers only while
+  // the current one is active, so the copy keeps the current cell's.
+  val copyNext =
+    if (p.has(Fault.HeadCopiedLate)) !active && !io.prepare.valid // misses the cycle after the start
+    else !active
+  val copying  = RegNext(copyNext, false.B)
+  val headCopy = replicatedEnable("headCopy", next = copyNext, now = copying)
   // headCopiedBeforeWritten: no head box of the next cell is written before
   // the copy of this one (the front end takes the next count at the start,
   // so its first box is written two cycles later at the earliest).
@@ -239,7 +254,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   // ---- the window: lane k holds object s+k ----
   val window = Reg(Vec(m, new Entry))
-  val entry  = readHead.io.deq.bits
+  val entry  = headEntry
   val windowShift = replicatedEnable(
     "windowShift",
     next = issuingNext && (io.room || p.has(Fault.LookaheadIgnoresRoom).B),
@@ -268,14 +283,17 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val capture     = RegInit(0.U(m.W)) // one-hot: which of the block's first m issues this is, 0 after them
   val captureNext = WireDefault(capture)
   capture := captureNext
-  val capturing     = RegInit(false.B) // capture =/= 0, as a register
-  val capturingNext = WireDefault(capturing)
+  val capturing      = RegInit(false.B) // capture =/= 0, as a register
+  val capturingCarry = WireDefault(capturing) // its next value unless a start is accepted
+  val capturingNext  = Mux(io.prepare.valid, true.B, capturingCarry)
   capturing := capturingNext
   assert(capturing === capture.orR, "the capture flag does not match its count")
   // Each lane's enable is a register computed a cycle ahead, as the window's
   // and the A block's are: `issuing` reached lane k's 192 enables through
   // issue && capture(k) (stream m = 64's critical path, 83.7 MHz, 11.0 ns of wire).
-  val aNextShift = replicatedEnable("aNextShift", next = issueNext && capturingNext, now = issue && capturing)
+  // The look-ahead reads the capture flag's start-free next value: in a cycle
+  // that accepts a start no run is active, so issueNext is false anyway.
+  val aNextShift = replicatedEnable("aNextShift", next = issueNext && capturingCarry, now = issue && capturing)
   for (k <- 0 until m) {
     when(headCopy(k)) {
       aNext(k) := headRegs(k)
@@ -320,11 +338,15 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     assert(leftIsOne === (left === 1.U) && blockLeftIsM === (blockLeft === m.U) &&
       blockLeftAtLeast2m === (blockLeft >= (2 * m).U), "the block-end flags do not match their counters")
   }
-  // The A block is copied from aNext through the startup and at each block change.
+  // The A block is copied from aNext in the startup's cycles after its first
+  // (aNext holds block 0 from the end of the first: the copy above), and at
+  // each block change. readLatency >= 2 gives the startup a second cycle.
+  require(p.readLatency >= 2)
+  val launched = RegNext(io.launch.valid, false.B) // the startup's first cycle
   val aLoad = replicatedEnable(
     "aLoad",
-    next = startingSoon || (issueNext && blockEndCarry && hasNextBlockCarry),
-    now = starting || (issue && blockEnd && hasNextBlock)
+    next = startingCarry || (issueNext && blockEndCarry && hasNextBlockCarry),
+    now = (starting && !launched) || (issue && blockEnd && hasNextBlock)
   )
   for (k <- 0 until m) when(aLoad(k)) { a(k) := aNext(k) }
   when(starting) {
@@ -342,7 +364,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       leftIsOne := left === 2.U
       blockEndCarry := leftIsOne
       captureNext := (capture << 1)(m - 1, 0)
-      capturingNext := capturing && !capture(m - 1)
+      capturingCarry := capturing && !capture(m - 1)
     }.elsewhen(hasNextBlock) {
       base         := base + m.U
       s            := base + (m + 1).U
@@ -355,7 +377,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       blockEndCarry     := blockLeftIsM
       hasNextBlockCarry := blockLeftAtLeast2m
       captureNext  := 1.U
-      capturingNext := true.B
+      capturingCarry := true.B
     }.otherwise {
       issuingNext := false.B
     }
@@ -380,7 +402,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     blockEndNext     := count === 2.U
     hasNextBlockNext := count >= (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 3 else 2)).U
     captureNext := 1.U
-    capturingNext := true.B
     rBase      := 0.U
     rBlockLeft := count - 2.U
     // R[m] is block 0's object m+1 when it exists; otherwise no later block
@@ -448,8 +469,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   /** One register per lane (`copies` of them) holding `next` of the last
     * cycle, checked to equal `now` except in a cycle where `unless` holds
-    * (by default the cycle after a start that did not launch, whose
-    * look-ahead took it for a launch): each copy drives one lane's 192
+    * (a look-ahead that may differ there says why that is harmless): each copy drives one lane's 192
     * clock enables, where one net drove all 192m (stream m = 64's critical
     * path: 12.4 ns of routing to about 12,000 flip-flops). Synthesis merges
     * identical registers unless told otherwise; the FPGA flow keeps the
@@ -460,7 +480,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     next: Bool,
     now: Bool,
     copies: Int = m,
-    unless: Bool = unlaunchedStart
+    unless: Bool = false.B
   ): Seq[Bool] = {
     // The reset enters once, at the source: reset on each copy sent the
     // wrapper's reset register to every lane (stream m = 64's critical path,
