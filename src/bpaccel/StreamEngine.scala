@@ -87,6 +87,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // ---- run state ----
   val starting = RegInit(false.B)
   val issuing  = RegInit(false.B)
+  val active   = starting || issuing // a run is under way
   val primeLeft = Reg(UInt(log2Ceil(p.readLatency + 1).W)) // cycles until the first read reaches the entry
   val issue     = issuing && advance
 
@@ -122,7 +123,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // reader register (the m = 8 critical path).
   private val readDepth = p.readLatency + 2
   val readCredits = RegInit(readDepth.U(log2Ceil(readDepth + 1).W))
-  val readEvent   = (starting || issuing) && readCredits =/= 0.U
+  val readEvent   = active && readCredits =/= 0.U
   readCredits := readCredits - readEvent.asUInt + issue.asUInt
   val rObj       = Reg(UInt(p.indexWidth.W))  // object read at the next read event
   val rLeft      = Reg(UInt(p.countWidth.W))  // objects after rObj in its block's stream
@@ -201,7 +202,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // critical path at 92b097e, 78.8 MHz: host start -> load ready -> a head
   // chain enable copy; taking it off that look-ahead alone moved it to the
   // next one, d26d030). Each look-ahead below says why it needs no start.
-  val active = starting || issuing
 
   // ---- objects 0 .. m: kept in a chain of head registers as they are loaded ----
   // Each head object enters the top register and moves every register
@@ -325,14 +325,14 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val hasNextBlockNext  = WireDefault(hasNextBlockCarry)
   blockEnd     := blockEndNext
   hasNextBlock := hasNextBlockNext
-  assert(!io.prepare.valid || !(starting || issuing), "a start was accepted while a run was active")
+  assert(!io.prepare.valid || !active, "a start was accepted while a run was active")
   // Their next values, in turn, from flags kept a step ahead of the counters,
   // so that no comparison sits in the enables' look-ahead either (the path
   // advance -> issue -> blockEndNext -> aLoad's copies, stream m = 32).
   val leftIsOne          = Reg(Bool()) // left == 1
   val blockLeftIsM       = Reg(Bool()) // blockLeft == m
   val blockLeftAtLeast2m = Reg(Bool()) // blockLeft >= 2m
-  when(starting || issuing) {
+  when(active) {
     assert(laneTop === left + headOffset && (headOffset === 0.U || !hasNextBlock),
       "the lanes' offset does not match the run")
     assert(leftIsOne === (left === 1.U) && blockLeftIsM === (blockLeft === m.U) &&
@@ -454,7 +454,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val atAnd     = Pipe(atCompare)
   require(p.pipelineLatency == 2)
 
-  io.activity.active   := starting || issuing
+  io.activity.active   := active
   io.activity.issued   := issue
   io.activity.stalled  := issuing && !advance
   io.activity.inFlight := atCompare.valid.asUInt +& atAnd.valid.asUInt
