@@ -113,6 +113,12 @@ case class AccelParams(
     */
   val overlapsLoads: Boolean = arch == Arch.Stream
 
+  /** Whether runs may be bipartite (a split in [[RunRequest]]): the stream's
+    * reader jumps over the objects of A a block does not test; the seed's
+    * schedule has no such jump, and refuses a split with an error.
+    */
+  val bipartiteRuns: Boolean = arch == Arch.Stream
+
   /** Objects 0 .. headObjects-1 of a run start it from registers: the seed's
     * block-0 A objects (m), the stream's head registers (m + 1: block 0's A
     * objects and its window).

@@ -27,7 +27,7 @@ import chisel3.util._
   */
 class BatchControl(p: AccelParams) extends Module {
   val io = IO(new Bundle {
-    val cells      = Flipped(Decoupled(UInt(p.countWidth.W)))
+    val cells      = Flipped(Decoupled(new RunRequest(p)))
     val hostStart  = Input(Bool()) // the host offers a single start: it wins over a batch's first count
     val runBusy    = Input(Bool()) // run control is running a run
     val loadFire   = Input(Bool()) // a box was accepted
@@ -35,7 +35,7 @@ class BatchControl(p: AccelParams) extends Module {
     val begin      = Output(Bool()) // this cycle accepts a batch's first count
     val take       = Valid(new CellCount(p)) // the head takes this count: the loader starts the cell's numbering
     val loadReady  = Output(Bool()) // the current cell wants another box
-    val start      = Valid(UInt(p.countWidth.W)) // start the current cell's run (run control is idle)
+    val start      = Valid(new RunRequest(p)) // start the current cell's run (run control is idle)
     val accumulate = Output(Bool()) // the start continues a batch: its counters add to the batch's
     val cellEnd    = Output(Bool()) // the front end's own cycle: the current cell ends
     val cell       = Output(UInt(p.cellTagWidth.W)) // tag of the beats entering the result queue
@@ -50,6 +50,7 @@ class BatchControl(p: AccelParams) extends Module {
   // counts and every count reaches the head in the cycle it would have
   // reached the head of a single queue.
   val current   = Reg(UInt(p.countWidth.W)) // the head cell's count; valid while `loading`
+  val currentSplit = Reg(UInt(p.countWidth.W)) // and its split
   val left      = Reg(UInt(p.countWidth.W)) // boxes of the head cell still to admit
   val wantsBox  = RegInit(false.B) // loading, and left =/= 0: the registered load-ready
   val active    = RegInit(false.B)
@@ -85,7 +86,8 @@ class BatchControl(p: AccelParams) extends Module {
 
   io.loadReady   := wantsBox
   io.start.valid := loading && !wantsBox && !running
-  io.start.bits  := current
+  io.start.bits.count := current
+  io.start.bits.split := currentSplit
   // A register, not cellsDone =/= 0: a 32-bit test in front of every counter's enable was the next m = 8 critical path.
   val cellEnded = RegInit(false.B) // a cell of this batch has ended
   io.accumulate := active && cellEnded
@@ -118,6 +120,7 @@ class BatchControl(p: AccelParams) extends Module {
   }
   when(tailFire) {
     current  := tail.bits.count
+    currentSplit := tail.bits.split
     left     := tail.bits.count
     wantsBox := tail.bits.nonEmpty
     loading  := true.B

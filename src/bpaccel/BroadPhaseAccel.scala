@@ -7,7 +7,8 @@ import chisel3.util._
   * architecture's engine and the result queue.
   *
   * Protocol: load boxes through `load` (object indices count from 0 in load
-  * order), then send n on `start`. Results arrive on `result` as beats of one
+  * order), then send n on `start` (with split 0; or na for a bipartite
+  * run, see [[RunRequest]]). Results arrive on `result` as beats of one
   * schedule cycle each (see [[ResultBeat]]); `status.done` rises once every
   * beat has been taken. A start resets the load pointer, so each run loads
   * its own boxes. A load beyond the capacity or a start with n larger than
@@ -28,8 +29,8 @@ import chisel3.util._
 class BroadPhaseAccel(val p: AccelParams) extends Module {
   val io = IO(new Bundle {
     val load     = Flipped(Decoupled(new Aabb(p.keyWidth)))
-    val start    = Flipped(Decoupled(UInt(p.countWidth.W)))
-    val cells    = Flipped(Decoupled(UInt(p.countWidth.W)))
+    val start    = Flipped(Decoupled(new RunRequest(p)))
+    val cells    = Flipped(Decoupled(new RunRequest(p)))
     val result   = Decoupled(new ResultBeat(p))
     val status   = Output(new AccelStatus(p))
     val counters = Output(new AccelCounters(p))
@@ -53,7 +54,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   batch.io.loadFire  := io.load.fire
 
   // The run control's start: the host's outside a batch, the front end's within one.
-  val start = Wire(Decoupled(UInt(p.countWidth.W)))
+  val start = Wire(Decoupled(new RunRequest(p)))
   start.valid    := Mux(batch.io.active, batch.io.start.valid, io.start.valid)
   start.bits     := Mux(batch.io.active, batch.io.start.bits, io.start.bits)
   io.start.ready := start.ready && !batch.io.active
@@ -140,6 +141,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   io.info.batchCells        := p.batchCells.U
   io.info.cellTagWidth      := p.cellTagWidth.U
   io.info.batchOverlapsLoads := p.overlapsLoads.B
+  io.info.bipartiteRuns      := p.bipartiteRuns.B
 
   io.debug.foreach(_ := engine.io.probe.get)
 

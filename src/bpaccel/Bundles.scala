@@ -27,17 +27,30 @@ class ResultBeat(p: AccelParams) extends ScheduleBeat(p) {
   val cell = UInt(p.cellTagWidth.W)
 }
 
+/** What a start or a batch cell asks for: a run of `count` objects, all
+  * pairs (`split` = 0), or a bipartite run (`split` = na in 1 .. count-1:
+  * only objects 0 .. na-1 against na .. count-1; stream architecture only).
+  */
+class RunRequest(p: AccelParams) extends Bundle {
+  val count = UInt(p.countWidth.W)
+  val split = UInt(p.countWidth.W)
+}
+
 /** Error codes of a run, also written into the C header. */
 object AccelError extends ChiselEnum {
   val None              = Value(0.U) // the run is fine
   val CountOverCapacity = Value(1.U) // start(n) with n > capacity
   val CountOverLoaded   = Value(2.U) // start(n) with fewer than n boxes loaded
   val LoadOverflow      = Value(3.U) // more than capacity boxes were loaded
+  val SplitOutOfRange   = Value(4.U) // a split other than 0 outside 1 .. n-1
+  val SplitUnsupported  = Value(5.U) // a split on an architecture without bipartite runs (the seed)
   val names: Seq[(String, Type)] = Seq(
     "NONE" -> None,
     "COUNT_OVER_CAPACITY" -> CountOverCapacity,
     "COUNT_OVER_LOADED" -> CountOverLoaded,
-    "LOAD_OVERFLOW" -> LoadOverflow
+    "LOAD_OVERFLOW" -> LoadOverflow,
+    "SPLIT_OUT_OF_RANGE" -> SplitOutOfRange,
+    "SPLIT_UNSUPPORTED" -> SplitUnsupported
   )
   def code(e: Type): Int = e.litValue.toInt
 }
@@ -91,6 +104,7 @@ class AccelInfo extends Bundle {
   val batchCells        = UInt(16.W) // cell counts the batch queue holds
   val cellTagWidth      = UInt(8.W)  // bits of a result beat's cell tag
   val batchOverlapsLoads = Bool()    // a batch loads its next cell while one runs
+  val bipartiteRuns     = Bool()     // starts and cells may carry a split (RunRequest)
 }
 
 /** The ports every architecture's engine offers the shared top level. */
@@ -98,7 +112,7 @@ class EngineIO(p: AccelParams) extends Bundle {
   val write    = Flipped(Valid(new LoadWrite(p)))
   val writeOffered = Input(Bool()) // write.valid, unless this cycle clears the loader (Loader)
   val loadClear    = Input(Bool()) // a start or a batch count restarts the numbering of loaded boxes
-  val prepare  = Flipped(Valid(UInt(p.countWidth.W))) // a start was accepted (launched or not), with its n
+  val prepare  = Flipped(Valid(new RunRequest(p))) // a start was accepted (launched or not), with its n and split
   val headPad  = Input(UInt(log2Ceil(p.headObjects + 1).W)) // with a start: the loader's head pad (Loader)
   val launch   = Flipped(Valid(UInt(p.countWidth.W))) // a run of n >= 2 objects, all loaded
   val room     = Input(Bool())                        // the result queue has room for one more issue next cycle

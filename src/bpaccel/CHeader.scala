@@ -40,6 +40,7 @@ object CHeader {
       "BATCH_CELLS"         -> p.batchCells.toString,
       "CELL_TAG_WIDTH"      -> p.cellTagWidth.toString,
       "BATCH_OVERLAPS_LOADS" -> (if (p.overlapsLoads) "1" else "0"),
+      "BIPARTITE_RUNS"      -> (if (p.bipartiteRuns) "1" else "0"),
       "FINGERPRINT"         -> s"\"${fingerprint(p)}\""
     ) ++ AccelError.names.map { case (name, e) => s"ERROR_$name" -> AccelError.code(e).toString }
     val body = defines.map { case (k, v) => s"#define BPACCEL_$k $v" }.mkString("\n")
@@ -58,6 +59,11 @@ object CHeader {
        | * startup(n) = 0 for the seed architecture, BPACCEL_READ_LATENCY for
        | * the stream architecture;
        | * runs with n < 2 take no cycles.
+       | * Bipartite runs (BPACCEL_BIPARTITE_RUNS): start and cells carry
+       | * {count, split}; split = 0 runs all pairs, split = na in 1 .. n-1 only
+       | * the pairs i < na <= j, in issue_cycles = sum over b = 0 .. (na-1)/M of
+       | * min(n - 1 - b*M, 2*M - 1 + n - na) (same startup and overhead).
+       | * Without it a split other than 0 fails with SPLIT_UNSUPPORTED.
        | * Counters: load_cycles counts the cycles from a run's first accepted box
        | * to the cycle that accepts its start, both included (n + 1 when the
        | * host loads one box a cycle and starts at once; 1 with no box);

@@ -24,14 +24,16 @@ class LoadWrite(p: AccelParams) extends Bundle {
   */
 class CellCount(p: AccelParams) extends Bundle {
   val count    = UInt(p.countWidth.W)
+  val split    = UInt(p.countWidth.W) // RunRequest's
   val nonEmpty = Bool() // count =/= 0
 }
 
 object CellCount {
-  def apply(p: AccelParams, count: UInt): CellCount = {
+  def apply(p: AccelParams, request: RunRequest): CellCount = {
     val c = Wire(new CellCount(p))
-    c.count    := count
-    c.nonEmpty := count =/= 0.U
+    c.count    := request.count
+    c.split    := request.split
+    c.nonEmpty := request.count =/= 0.U
     c
   }
 }

@@ -29,7 +29,7 @@ class EngineActivity(p: AccelParams) extends Bundle {
   */
 class RunControl(p: AccelParams) extends Module {
   val io = IO(new Bundle {
-    val start      = Flipped(Decoupled(UInt(p.countWidth.W)))
+    val start      = Flipped(Decoupled(new RunRequest(p)))
     val accumulate = Input(Bool()) // this start continues a batch
     val batchBegin = Input(Bool()) // a batch's first count is accepted: its load time starts
     val batchActive = Input(Bool()) // a batch is under way
@@ -75,15 +75,18 @@ class RunControl(p: AccelParams) extends Module {
   }
 
   io.launch.valid := false.B
-  io.launch.bits  := io.start.bits
+  io.launch.bits  := io.start.bits.count
   when(io.start.fire) {
-    val n = io.start.bits
+    val n     = io.start.bits.count
+    val split = io.start.bits.split
     val code = MuxCase(
       AccelError.None,
       Seq(
         io.overflow            -> AccelError.LoadOverflow,
         (n > p.capacity.U)     -> AccelError.CountOverCapacity,
-        (n > io.loaded)        -> AccelError.CountOverLoaded
+        (n > io.loaded)        -> AccelError.CountOverLoaded,
+        (split =/= 0.U && !p.bipartiteRuns.B) -> AccelError.SplitUnsupported,
+        (split =/= 0.U && split >= n) -> AccelError.SplitOutOfRange
       )
     )
     error := Mux(io.accumulate && error =/= AccelError.None, error, code)

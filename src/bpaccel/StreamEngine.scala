@@ -46,9 +46,13 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   private val m = p.m
   private val W = 6 * p.keyWidth
 
-  /** A box and, with the debug port, the object index it came from. */
+  /** A box, whether its object belongs to set B (always, in a triangular
+    * run; meaningful in the window only) and, with the debug port, the
+    * object index it came from.
+    */
   class Entry extends Bundle {
     val box = UInt(W.W)
+    val inB = Bool()
     val tag = UInt((if (p.debugPort) p.indexWidth else 0).W)
   }
   private def tagOf(index: UInt): UInt = if (p.debugPort) index else 0.U(0.W)
@@ -129,22 +133,43 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val rLeft      = Reg(UInt(p.countWidth.W))  // objects after rObj in its block's stream
   val rBlockLeft = Reg(UInt(p.countWidth.W))  // n-2-base of rObj's block
   val rBase      = Reg(UInt(p.countWidth.W))
+  // The run's constants, from its start: its split (0: triangular), and the
+  // stream objects after a bipartite block's first, 2m-2+nb (nb = n - split,
+  // so n + 2m - 2 for a triangular run: never the smaller of the two below).
+  val runSplit      = Reg(UInt(p.countWidth.W))
+  val bipartiteLeft = Reg(UInt(log2Ceil(p.capacity + 2 * m).W))
+  private def minOf(a: UInt, b: UInt): UInt = Mux(a < b, a, b)
+  private def maxOf(a: UInt, b: UInt): UInt = Mux(a > b, a, b)
   // The stream's tests, one read ahead as the schedule's are: rLeft == 0, rBlockLeft >= m.
   val rBlockEnd     = Reg(Bool())
   val rHasNextBlock = Reg(Bool())
+  val rALeft        = Reg(UInt(p.countWidth.W)) // lastA-base of rObj's block
+  // A bipartite block's stream jumps from its prefix (base+1 .. base+2m-1,
+  // which carries the next A block past the top lane) to max(base+2m, na):
+  // the A objects in between meet nothing of B (Schedule). A triangular
+  // run's jump target is base+2m, the next object anyway.
+  val rAtJump     = Reg(Bool())               // rObj is the prefix's last object, base+2m-1
+  val rBeforeJump = Reg(UInt(p.countWidth.W)) // base+2m-2
+  val rJumpTo     = Reg(UInt(p.countWidth.W)) // max(base+2m, na)
   when(readEvent) {
     when(!rBlockEnd) {
-      rObj      := rObj + 1.U
+      rObj      := Mux(rAtJump, rJumpTo, rObj + 1.U)
+      rAtJump   := !rAtJump && rObj === rBeforeJump
       rLeft     := rLeft - 1.U
       rBlockEnd := rLeft === 1.U
     }.elsewhen(rHasNextBlock) {
-      // Next block's stream: objects base+m+1 .. n-1.
+      // Next block's stream: objects base+m+1 .. base+3m-1, then max(base+3m, na) .. n-1.
+      val nextLeft = minOf(rBlockLeft - m.U, bipartiteLeft)
       rBase         := rBase + m.U
       rObj          := rBase + (m + 1).U
-      rLeft         := rBlockLeft - m.U
+      rLeft         := nextLeft
       rBlockLeft    := rBlockLeft - m.U
-      rBlockEnd     := rBlockLeft === m.U
-      rHasNextBlock := rBlockLeft >= (2 * m).U
+      rBlockEnd     := rBlockLeft === m.U // nextLeft == 0: bipartiteLeft >= 1
+      rALeft        := rALeft - m.U
+      rHasNextBlock := rALeft >= (2 * m).U
+      rAtJump       := (m == 1).B
+      rBeforeJump   := rBase + (3 * m - 2).U
+      rJumpTo       := maxOf(rBase + (3 * m).U, runSplit)
     } // past the last block the stream is never compared: hold
   }
   // readsNeverMeetWrites: while a run reads its bank, boxes are written only
@@ -157,6 +182,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val read = Wire(Valid(new Entry))
   read.valid    := RegNext(readEvent, false.B)
   read.bits.tag := RegNext(tagOf(rObj))
+  read.bits.inB := RegNext(rObj >= runSplit)
   // The read, then memoryOutputStages registers; the first may sit in the block RAM.
   val readStages = (mem, registeredMem) match {
     case (Some(mem), _) =>
@@ -172,6 +198,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       val first = Wire(Valid(new Entry))
       first.valid    := RegNext(read.valid, false.B)
       first.bits.tag := RegEnable(read.bits.tag, read.valid)
+      first.bits.inB := RegEnable(read.bits.inB, read.valid)
       first.bits.box := mem.io.readData
       read +: Seq.iterate(first, p.memoryOutputStages)(x => Pipe(x))
     case _ => throw new IllegalStateException("one of the two memories exists")
@@ -228,6 +255,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   for (k <- 0 to m) when(headShift(k)) {
     if (k == m) {
       headRegs(k).box := loadedBox.bits.box.asUInt
+      headRegs(k).inB := DontCare // set by lane at the copy into the window
       headRegs(k).tag := tagOf(loadedBox.bits.index)
     } else headRegs(k) := headRegs(k + 1)
   }
@@ -261,10 +289,13 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     now = issue
   )
   // The window takes objects 1 .. m from the head registers at the copy.
+  // Lane k then holds object k+1-d, in B when k+1 >= split + d (`splitLane`, 0 for a triangular run).
   private val copiedToLane = if (p.has(Fault.HeadCopyOffByOne)) 0 else 1
+  val splitLane = Reg(UInt(p.countWidth.W))
   for (k <- 0 until m) {
     when(headCopy(k)) {
-      window(k) := headRegs(k + copiedToLane)
+      window(k)     := headRegs(k + copiedToLane)
+      window(k).inB := (k + 1).U >= splitLane
     }.elsewhen(windowShift(k)) {
       window(k) := (if (k == m - 1) entry else window(k + 1))
     }
@@ -307,6 +338,10 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val s         = Reg(UInt(p.countWidth.W))
   val left      = Reg(UInt(p.countWidth.W)) // n-1-s: cycles after this one in the block
   val blockLeft = Reg(UInt(p.countWidth.W)) // n-2-base
+  val nMinus1   = Reg(UInt(p.countWidth.W)) // s = n-1-left: lane 0 ends every block at object n-1
+  // Blocks run while base <= lastA (n-2, or na-1 for a bipartite run); lane k's A object base+k-d is in A while k <= aTop.
+  val aLeft     = Reg(UInt(p.countWidth.W)) // lastA-base
+  val aTop      = Reg(UInt(p.countWidth.W)) // aLeft + headOffset
   // The run's lanes start `headOffset` lanes up (d above; 0 unless n < m + 2),
   // so lane k holds object s + k - d, which exists while k <= left + d = laneTop.
   val headOffset = Reg(UInt(log2Ceil(p.headObjects + 1).W))
@@ -314,7 +349,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // The block-end test, computed one cycle ahead so that no comparison sits
   // between the issue and the enables of the A registers.
   val blockEnd     = Reg(Bool()) // left == 0
-  val hasNextBlock = Reg(Bool()) // blockLeft >= m
+  val hasNextBlock = Reg(Bool()) // aLeft >= m
   // `*Carry`: the next value unless a start is accepted. The look-ahead of
   // aLoad reads these: a start is accepted only while no run is active, so
   // its issue term is false then anyway, and the start count's compares stay
@@ -331,12 +366,13 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // advance -> issue -> blockEndNext -> aLoad's copies, stream m = 32).
   val leftIsOne          = Reg(Bool()) // left == 1
   val blockLeftIsM       = Reg(Bool()) // blockLeft == m
-  val blockLeftAtLeast2m = Reg(Bool()) // blockLeft >= 2m
+  val aLeftAtLeast2m     = Reg(Bool()) // aLeft >= 2m
   when(active) {
-    assert(laneTop === left + headOffset && (headOffset === 0.U || !hasNextBlock),
+    assert(laneTop === left + headOffset && aTop === aLeft + headOffset && (headOffset === 0.U || !hasNextBlock),
       "the lanes' offset does not match the run")
+    assert(s === nMinus1 - left, "the window's start does not match its count of cycles left")
     assert(leftIsOne === (left === 1.U) && blockLeftIsM === (blockLeft === m.U) &&
-      blockLeftAtLeast2m === (blockLeft >= (2 * m).U), "the block-end flags do not match their counters")
+      aLeftAtLeast2m === (aLeft >= (2 * m).U), "the block-end flags do not match their counters")
   }
   // The A block is copied from aNext in the startup's cycles after its first
   // (aNext holds block 0 from the end of the first: the copy above), and at
@@ -366,16 +402,22 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       captureNext := (capture << 1)(m - 1, 0)
       capturingCarry := capturing && !capture(m - 1)
     }.elsewhen(hasNextBlock) {
+      // A bipartite block that jumps starts with lane 0 at virtual object
+      // n-1-left: the lanes from the jump on hold it + k, the prefix's lanes
+      // before it hold A objects and are masked.
+      val nextLeft = minOf(blockLeft - m.U, bipartiteLeft)
       base         := base + m.U
-      s            := base + (m + 1).U
-      left         := blockLeft - m.U
-      laneTop      := blockLeft - m.U // headOffset = 0: this run has n >= m + 2
+      s            := nMinus1 - nextLeft
+      left         := nextLeft
+      laneTop      := nextLeft // headOffset = 0: this run has n >= m + 2
       blockLeft    := blockLeft - m.U
-      leftIsOne          := blockLeft === (m + 1).U
+      aLeft        := aLeft - m.U
+      aTop         := aLeft - m.U
+      leftIsOne          := nextLeft === 1.U
       blockLeftIsM       := blockLeft === (2 * m).U
-      blockLeftAtLeast2m := blockLeft >= (3 * m).U
-      blockEndCarry     := blockLeftIsM
-      hasNextBlockCarry := blockLeftAtLeast2m
+      aLeftAtLeast2m     := aLeft >= (3 * m).U
+      blockEndCarry     := blockLeftIsM // nextLeft == 0: bipartiteLeft >= 1
+      hasNextBlockCarry := aLeftAtLeast2m
       captureNext  := 1.U
       capturingCarry := true.B
     }.otherwise {
@@ -386,31 +428,48 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // not: they are read only while starting or issuing, so the start's
   // decoded error checks (the launch) reach only the flags below, not all of
   // these enables (stream m = 32's critical path).
-  assert(!io.launch.valid || (io.prepare.valid && io.prepare.bits === io.launch.bits), "a launch without its start")
+  assert(!io.launch.valid || (io.prepare.valid && io.prepare.bits.count === io.launch.bits), "a launch without its start")
   when(io.prepare.valid) {
-    val count = io.prepare.bits // >= 2 when it launches
+    val count = io.prepare.bits.count // >= 2 when it launches
+    val split = io.prepare.bits.split // 0, or 1 .. count-1 when it launches
+    val bipartite = split =/= 0.U
+    val lastA     = Mux(bipartite, split - 1.U, count - 2.U)
+    val bipLeft   = (2 * m - 2).U +& (count - split)
+    val left0     = minOf(count - 2.U, bipLeft) // block 0's cycles after its first
+    runSplit      := split
+    bipartiteLeft := bipLeft
+    splitLane     := Mux(bipartite, split + io.headPad, 0.U)
     primeLeft := p.readLatency.U
     base      := 0.U
-    s         := 1.U
-    left      := count - 2.U
+    s         := count - 1.U - left0
+    nMinus1   := count - 1.U
+    left      := left0
     blockLeft := count - 2.U
+    aLeft     := lastA
     headOffset := io.headPad
-    laneTop    := count - 2.U + io.headPad
-    leftIsOne          := count === 3.U
+    laneTop    := left0 + io.headPad
+    aTop       := lastA + io.headPad
+    leftIsOne          := left0 === 1.U
     blockLeftIsM       := count === (m + 2).U
-    blockLeftAtLeast2m := count >= (2 * m + 2).U
-    blockEndNext     := count === 2.U
-    hasNextBlockNext := count >= (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 3 else 2)).U
+    aLeftAtLeast2m     := lastA >= (2 * m).U
+    blockEndNext     := count === 2.U // left0 == 0
+    hasNextBlockNext := lastA >= (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 1 else 0)).U
     captureNext := 1.U
     rBase      := 0.U
     rBlockLeft := count - 2.U
-    // R[m] is block 0's object m+1 when it exists; otherwise no later block
-    // exists and the stream past block 0 is never compared.
+    rALeft     := lastA
+    // R[m], block 0's stream object m: object m+1 while m+1 lies in its
+    // prefix (m >= 2), else the jump's target. Without it (n < m + 2) no
+    // later block exists and the stream past block 0 is never compared.
     val longBlock = count >= (m + 2).U
-    rObj  := Mux(longBlock, (m + 1).U, 0.U)
-    rLeft := Mux(longBlock, count - (m + 2).U, 0.U)
-    rBlockEnd     := !longBlock || count === (m + 2).U
-    rHasNextBlock := longBlock // rBlockLeft = count-2 >= m
+    val jumpTo0   = maxOf((2 * m).U, split)
+    rObj  := Mux(longBlock, (if (m >= 2) (m + 1).U else jumpTo0), 0.U)
+    rLeft := Mux(longBlock, left0 - m.U, 0.U)
+    rBlockEnd     := !longBlock || left0 === m.U
+    rHasNextBlock := lastA >= m.U // then longBlock: n - 2 >= lastA >= m
+    rAtJump       := (m == 2).B // object m+1 = 2m-1 ends the prefix
+    rBeforeJump   := (2 * m - 2).U
+    rJumpTo       := jumpTo0
   }
   when(io.launch.valid) { readCredits := readDepth.U }
 
@@ -432,8 +491,11 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     // laneTop >= k: from a register directly, not from n - s (that
     // subtraction in front of the compares was stream m = 32's critical
     // path, 105.5 MHz). Lanes below d hold no object of the run.
+    // A bipartite run also masks lanes whose B object is in A, and those
+    // past the last A object.
     headOffset <= k.U &&
-      (if (p.has(Fault.LaneMaskOneTooWide)) laneTop +& 1.U >= k.U else laneTop >= k.U))).asUInt
+      (if (p.has(Fault.LaneMaskOneTooWide)) laneTop +& 1.U >= k.U else laneTop >= k.U) &&
+      aTop >= k.U && window(k).inB)).asUInt
   if (p.debugPort) {
     // The objects each lane really holds, from the tags that travelled with
     // the data, moved down by d lanes as the hit mask is.

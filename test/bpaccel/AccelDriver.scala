@@ -46,7 +46,9 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
   def idleInputs(): Unit = {
     dut.io.load.valid.poke(false.B)
     dut.io.start.valid.poke(false.B)
+    dut.io.start.bits.split.poke(0.U)
     dut.io.cells.valid.poke(false.B)
+    dut.io.cells.bits.split.poke(0.U)
     dut.io.result.ready.poke(false.B)
   }
 
@@ -68,21 +70,23 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
     dut.io.load.valid.poke(false.B)
   }
 
-  /** Sends start(n) for one cycle and returns without waiting for the run. */
-  def pulseStart(n: Int): Long = {
+  /** Sends start(n, split) for one cycle and returns without waiting for the run. */
+  def pulseStart(n: Int, split: Int = 0): Long = {
     dut.io.start.valid.poke(true.B)
-    dut.io.start.bits.poke(n.U)
+    dut.io.start.bits.count.poke(n.U)
+    dut.io.start.bits.split.poke(split.U)
     if (!dut.io.start.ready.peek().litToBoolean) fail("start.ready is low while the accelerator is idle")
     step()
     dut.io.start.valid.poke(false.B)
+    dut.io.start.bits.split.poke(0.U)
     val loadCycles = loadSteps.getOrElse(1L)
     loadSteps = None
     loadCycles
   }
 
-  /** Sends start(n) and plays the consumer until done, with `ready(cycle)` as its pattern. */
-  def start(n: Int, ready: Int => Boolean = _ => true): RunOutcome = {
-    val driverLoadCycles = pulseStart(n)
+  /** Sends start(n, split) and plays the consumer until done, with `ready(cycle)` as its pattern. */
+  def start(n: Int, ready: Int => Boolean = _ => true, split: Int = 0): RunOutcome = {
+    val driverLoadCycles = pulseStart(n, split)
 
     val pairs  = Seq.newBuilder[(Int, Int)]
     val probes = Vector.newBuilder[Vector[Option[(Int, Int)]]]
@@ -135,8 +139,9 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
     * cycle (counts first when both are offered at once, as the port wants),
     * and plays the consumer with `ready(cycle)` until the batch is over.
     */
-  def batch(cells: Seq[Seq[Box]], ready: Int => Boolean = _ => true): BatchOutcome = {
+  def batch(cells: Seq[Seq[Box]], ready: Int => Boolean = _ => true, splits: Seq[Int] = Nil): BatchOutcome = {
     val counts = cells.map(_.length)
+    require(splits.isEmpty || splits.length == cells.length, "one split per cell")
     val boxes  = cells.flatten // each cell in index order
     var nextCount, nextBox = 0
     var began = false
@@ -146,7 +151,10 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
       if (cycle >= maxCyclesPerRun) fail(s"batch of ${counts.length} cells did not finish within $maxCyclesPerRun cycles")
       val countOffered = nextCount < counts.length
       dut.io.cells.valid.poke(countOffered.B)
-      if (countOffered) dut.io.cells.bits.poke(counts(nextCount).U)
+      if (countOffered) {
+        dut.io.cells.bits.count.poke(counts(nextCount).U)
+        dut.io.cells.bits.split.poke(splits.lift(nextCount).getOrElse(0).U)
+      }
       val boxOffered = nextBox < boxes.length
       dut.io.load.valid.poke(boxOffered.B)
       if (boxOffered) pokeBox(boxes(nextBox))
@@ -188,8 +196,8 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
     )
   }
 
-  def run(boxes: Seq[Box], ready: Int => Boolean = _ => true): RunOutcome = {
+  def run(boxes: Seq[Box], ready: Int => Boolean = _ => true, split: Int = 0): RunOutcome = {
     load(boxes)
-    start(boxes.length, ready)
+    start(boxes.length, ready, split)
   }
 }

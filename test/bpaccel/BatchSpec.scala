@@ -34,7 +34,14 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
   private def frontEndCycles(cells: Int): (Long, Long) = (1L, cells.toLong)
 
   /** Pairs per cell against the golden model, tags in cell order, counters in closed form. */
-  private def checkBatch(p: AccelParams, cells: Seq[Seq[Box]], out: BatchOutcome, consumerNeverStalls: Boolean): Unit = {
+  private def checkBatch(
+    p: AccelParams,
+    cells: Seq[Seq[Box]],
+    out: BatchOutcome,
+    consumerNeverStalls: Boolean,
+    splits: Seq[Int] = Nil
+  ): Unit = {
+    val cellSplits = cells.indices.map(splits.lift(_).getOrElse(0))
     val tagSpace = 1 << p.cellTagWidth
     out.error shouldBe AccelError.code(AccelError.None)
     out.cellsDone shouldBe cells.length.toLong
@@ -47,12 +54,12 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
     }
     numbered.distinct.length shouldBe numbered.length
     for ((boxes, k) <- cells.zipWithIndex) withClue(s"cell $k (n=${boxes.length}): ") {
-      numbered.filter(_._1 == k).map { case (_, i, j) => (i, j) }.toSet shouldBe Box.bruteForcePairs(boxes)
+      numbered.filter(_._1 == k).map { case (_, i, j) => (i, j) }.toSet shouldBe Box.bruteForcePairs(boxes, cellSplits(k))
     }
     out.hits shouldBe out.pairs.length.toLong
     val sizes = cells.map(_.length.toLong)
     val (perBatch, perCells) = frontEndCycles(cells.length)
-    out.issueCycles shouldBe sizes.map(n => Schedule.issueCycles(n.toInt, p.m)).sum
+    out.issueCycles shouldBe sizes.zip(cellSplits).map { case (n, split) => Schedule.issueCycles(n, p.m, split) }.sum
     // Without overlap: one box a cycle, then the cell's start, whatever the consumer does.
     if (!p.overlapsLoads) out.loadCycles shouldBe perBatch + sizes.map(_ + 1).sum
     out.cycles shouldBe out.issueCycles + out.stallCycles + sizes.map(p.fixedCycles).sum + perCells
@@ -60,7 +67,7 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
     (out.loadCycles + out.cycles) shouldBe out.driverCycles
     if (consumerNeverStalls) {
       out.stallCycles shouldBe 0
-      val timeline = BatchTimelineModel(p, cells.map(_.length))
+      val timeline = BatchTimelineModel(p, cells.map(_.length), cellSplits)
       withClue("against the golden timeline: ") {
         (out.loadCycles, out.cycles) shouldBe ((timeline.load, timeline.run))
       }
@@ -111,6 +118,35 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
           }
         }
         withClue("no pattern ever back-pressured a batch, so stalls went untested: ") { sawStalls shouldBe true }
+      }
+    }
+
+  for (p <- Seq(configurations(3), configurations(4), configurations(7)))
+    it should s"run bipartite cells among triangular ones, each with exactly its A x B pairs, under back-pressure (${named(p)})" in {
+      withDriver(p) { (dut, drv) =>
+        val rng = new Random(13 * p.m)
+        for {
+          round            <- 0 until 3
+          (pattern, ready) <- readyPatterns(rng.nextInt())
+        } {
+          val sizes  = cellSizes(rng, p, 1 + rng.nextInt(p.batchCells))
+          val splits = sizes.map(n => if (n >= 2 && rng.nextInt(3) != 0) 1 + rng.nextInt(n - 1) else 0)
+          val cells  = sizes.map(cellBoxes(rng, p, _))
+          withClue(s"round $round, cells ${sizes.zip(splits).mkString(",")}, consumer '$pattern': ") {
+            val out = drv.batch(cells, ready, splits)
+            checkBatch(p, cells, out, consumerNeverStalls = pattern == "always ready", splits)
+          }
+        }
+        // The same cells as single runs: the batch costs their runs plus the front end's cycles.
+        val sizes  = Seq(p.capacity, p.m + 2, 2, p.capacity)
+        val splits = Seq(p.capacity / 2, 1, 1, p.capacity - 1)
+        val cells  = sizes.map(cellBoxes(rng, p, _))
+        val singles = cells.zip(splits).map { case (c, split) => drv.run(c, split = split) }
+        for (((c, split), single) <- cells.zip(splits).zip(singles))
+          checkRun(p, c, single, consumerNeverStalls = true, split = split)
+        val batch = drv.batch(cells, splits = splits)
+        checkBatch(p, cells, batch, consumerNeverStalls = true, splits)
+        batch.cycles shouldBe singles.map(_.cycles).sum + frontEndCycles(cells.length)._2
       }
     }
 
@@ -196,7 +232,7 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
       val rng = new Random(9)
       drv.load(Box.Scenes.uniform(rng, 5, p.keyWidth, 30, 10)) // never started
       dut.io.cells.valid.poke(true.B)
-      dut.io.cells.bits.poke(6.U)
+      dut.io.cells.bits.count.poke(6.U)
       dut.io.cells.ready.expect(true.B)
       dut.clock.step()
       dut.io.cells.valid.poke(false.B)

@@ -19,16 +19,17 @@ object BatchTimelineModel {
     def total: Long = load + run
   }
 
-  def apply(p: AccelParams, sizes: Seq[Int]): Cycles = {
+  /** `splits`: each cell's split (none: all triangular). */
+  def apply(p: AccelParams, sizes: Seq[Int], splits: Seq[Int] = Nil): Cycles = {
     require(sizes.nonEmpty, "a batch has at least one cell")
     var take    = 0L  // the head takes this cell's count
     var lastEnd = -1L // the cycle the cell before ended
     var run     = 0L
-    for (n <- sizes) {
+    for ((n, split) <- sizes.zipAll(splits, 0, 0)) {
       val taken    = take + n // the cycle of the last box taken (or of the count)
       val start    = math.max(taken + 1, lastEnd + 1)
       val launched = n >= 2 && n <= p.capacity
-      val busy     = if (launched) p.fixedCycles(n) + Schedule.issueCycles(n, p.m) else 0L
+      val busy     = if (launched) p.fixedCycles(n) + Schedule.issueCycles(n, p.m, split) else 0L
       val end      = start + busy + 1
       run += busy + 1
       lastEnd = end

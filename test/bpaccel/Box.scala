@@ -9,10 +9,12 @@ case class Box(min: Seq[BigInt], max: Seq[BigInt]) {
 }
 
 object Box {
-  def bruteForcePairs(boxes: Seq[Box]): Set[(Int, Int)] =
+  /** Every overlapping pair i < j; with a split na > 0, only those with i < na <= j. */
+  def bruteForcePairs(boxes: Seq[Box], split: Int = 0): Set[(Int, Int)] =
     (for {
       i <- boxes.indices
       j <- (i + 1) until boxes.length
+      if split == 0 || (i < split && j >= split)
       if boxes(i).overlaps(boxes(j))
     } yield (i, j)).toSet
 

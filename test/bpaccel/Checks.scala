@@ -6,16 +6,16 @@ import org.scalatest.matchers.should.Matchers
 trait Checks extends Matchers {
 
   /** Pairs, counters and cycle accounting of one run against the reference. */
-  def checkRun(p: AccelParams, boxes: Seq[Box], out: RunOutcome, consumerNeverStalls: Boolean): Unit = {
+  def checkRun(p: AccelParams, boxes: Seq[Box], out: RunOutcome, consumerNeverStalls: Boolean, split: Int = 0): Unit = {
     val n = boxes.length
     out.error shouldBe AccelError.code(AccelError.None)
     out.pairs.foreach { case (i, j) =>
       withClue(s"pair ($i, $j): ") { i should be < j; j should be < n }
     }
     out.pairs.distinct.length shouldBe out.pairs.length // nothing reported twice
-    out.pairs.toSet shouldBe Box.bruteForcePairs(boxes) // nothing missed, nothing extra
+    out.pairs.toSet shouldBe Box.bruteForcePairs(boxes, split) // nothing missed, nothing extra
     out.hits shouldBe out.pairs.length.toLong
-    out.issueCycles shouldBe Schedule.issueCycles(n, p.m)
+    out.issueCycles shouldBe Schedule.issueCycles(n, p.m, split)
     // The hardware's counters against the clock steps the driver itself saw.
     out.cycles shouldBe out.driverCycles
     out.loadCycles shouldBe out.driverLoadCycles
@@ -25,13 +25,13 @@ trait Checks extends Matchers {
   }
 
   /** The hardware's per-lane probes against the golden model, cycle by cycle. */
-  def checkSchedule(p: AccelParams, n: Int, out: RunOutcome): Unit = {
+  def checkSchedule(p: AccelParams, n: Int, out: RunOutcome, split: Int = 0): Unit = {
     val golden = p.arch match {
-      case Arch.Seed   => SeedScheduleModel.cycles(n, p.m)
-      case Arch.Stream => StreamScheduleModel.cycles(n, p.m, p.readLatency)
+      case Arch.Seed   => require(split == 0, "the seed runs no bipartite runs"); SeedScheduleModel.cycles(n, p.m)
+      case Arch.Stream => StreamScheduleModel.cycles(n, p.m, p.readLatency, split)
     }
     out.probeCycles.length shouldBe golden.length
     for (((hw, gm), c) <- out.probeCycles.zip(golden).zipWithIndex)
-      withClue(s"m=${p.m} n=$n cycle $c: ") { hw shouldBe gm }
+      withClue(s"m=${p.m} n=$n split=$split cycle $c: ") { hw shouldBe gm }
   }
 }

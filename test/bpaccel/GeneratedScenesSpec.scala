@@ -60,7 +60,7 @@ class GeneratedScenesSpec extends AnyFlatSpec with Simulators with Checks with S
   }
 
   /** Runs every generated scenario on one configuration, against `reference`. */
-  private def check(p: AccelParams, scenarios: Int, reference: Seq[Box] => Set[(Int, Int)] = Box.bruteForcePairs): Unit =
+  private def check(p: AccelParams, scenarios: Int, reference: Seq[Box] => Set[(Int, Int)] = Box.bruteForcePairs(_)): Unit =
     onVerilator(p) { dut =>
       val drv = new AccelDriver(dut)
       drv.idleInputs()

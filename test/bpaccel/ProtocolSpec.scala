@@ -72,6 +72,22 @@ class ProtocolSpec extends AnyFlatSpec with Simulators with Checks {
       }
     }
 
+    "A start with a split" should s"fail with ${if (p.bipartiteRuns) "SplitOutOfRange when the split is not below n" else "SplitUnsupported"}, without results $arch" in {
+      withDut { (dut, drv) =>
+        val b = boxes(7, 9)
+        for (split <- if (p.bipartiteRuns) Seq(7, 8, p.capacity) else Seq(1, 3, 6)) withClue(s"split $split: ") {
+          drv.load(b)
+          val out = drv.start(7, split = split)
+          out.error shouldBe AccelError.code(if (p.bipartiteRuns) AccelError.SplitOutOfRange else AccelError.SplitUnsupported)
+          out.pairs shouldBe empty
+          out.cycles shouldBe 0
+        }
+        dut.io.info.bipartiteRuns.expect(p.bipartiteRuns.B)
+        // The error does not stick: a correct run follows.
+        checkRun(p, b, drv.run(b), consumerNeverStalls = true)
+      }
+    }
+
     // The host always loads exactly n, but the protocol allows fewer: the
     // boxes after the first n must play no part. (Found by the whole-run
     // formal check at m = 2: the stream's window, filled from the loads,

@@ -67,6 +67,40 @@ class ScheduleHardwareSpec extends AnyFlatSpec with Simulators with Checks {
       )
     }
 
+  /** Bipartite runs of every n and split up to the capacity, on one simulator
+    * (so a bipartite run after a triangular one and the reverse are covered too).
+    */
+  private def bipartiteAllSplits(m: Int, capacity: Int, counts: Seq[Int], memoryStyle: MemoryStyle): Unit = {
+    val p = AccelParams(m = m, capacity = capacity, debugPort = true, arch = Arch.Stream, memoryStyle = memoryStyle)
+    onVerilator(p) { dut =>
+      val drv = new AccelDriver(dut)
+      drv.idleInputs()
+      val rng = new Random(100 + m)
+      for (n <- counts; split <- 0 until n) withClue(s"m=$m n=$n split=$split: ") {
+        val boxes = Box.Scenes.uniform(rng, n, p.keyWidth, span = 40, maxExtent = 12)
+        val out   = drv.run(boxes, split = split)
+        checkSchedule(p, n, out, split)
+        checkRun(p, boxes, out, consumerNeverStalls = true, split = split)
+      }
+    }
+  }
+
+  behavior of "The stream architecture's bipartite runs"
+
+  for (m <- Seq(1, 2, 3, 4))
+    it should s"match the bipartite golden model for m=$m, every n up to the capacity and every split" in {
+      bipartiteAllSplits(m, capacity = 4 * m + 3, counts = 2 to 4 * m + 3, MemoryStyle.Inferred)
+    }
+
+  for (m <- Seq(7, 16))
+    it should s"match the bipartite golden model for m=$m around block edges, every split" in {
+      bipartiteAllSplits(m, capacity = 3 * m + 2, counts = Seq(2, m, m + 1, m + 2, 2 * m + 1, 3 * m + 2), MemoryStyle.Inferred)
+    }
+
+  it should "match the bipartite golden model with the output register inside the block RAM (m=3)" in {
+    bipartiteAllSplits(3, capacity = 14, counts = 2 to 14, MemoryStyle.Ecp5OutputRegister)
+  }
+
   behavior of "The schedule with the output register inside the block RAM (memory style ecp5-outreg)"
 
   // The same golden models and cycle formulas: the style moves a register, it adds none.

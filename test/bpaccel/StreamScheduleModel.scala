@@ -17,6 +17,11 @@ package bpaccel
   *  - In cycle d < m of a block, the top lane's object is copied into the
   *    next block's A register d. A block ends when lane 0 holds its last
   *    object; the next block's A registers then become the current ones.
+  *  - A bipartite run (`split` = na > 0) tests A = objects 0 .. na-1 against
+  *    B = na .. n-1 only. It runs the A blocks alone, and block b's B
+  *    objects are b*m+1 .. b*m+2m-1 (which carry the next A block past the
+  *    top lane), then max(b*m+2m, na) .. n-1. A lane is compared when its B
+  *    object lies in B and its A object in A.
   */
 object StreamScheduleModel {
   type Lane = Option[(Int, Int)]
@@ -27,11 +32,20 @@ object StreamScheduleModel {
 
   case class Run(cycles: Vector[Vector[Lane]], startupCycles: Int)
 
-  def run(n: Int, m: Int, readLatency: Int): Run = {
+  def run(n: Int, m: Int, readLatency: Int, split: Int = 0): Run = {
     require(m >= 1 && readLatency >= 1)
+    require(split == 0 || (split >= 1 && split < n), s"split $split outside 1 .. n-1 = ${n - 1}")
     if (n < 2) return Run(Vector.empty, 0)
-    val blocks = (n - 2) / m + 1
-    val stream = (0 until blocks).flatMap(b => (b * m + 1 until n).map(Item(_, b)))
+    val lastA  = if (split == 0) n - 2 else split - 1
+    val blocks = lastA / m + 1
+    def blockStream(b: Int): Seq[Int] = {
+      val base = b * m
+      if (split == 0) base + 1 until n
+      else (base + 1 until (base + 2 * m).min(n)) ++ ((base + 2 * m).max(split) until n)
+    }
+    val stream = (0 until blocks).flatMap(b => blockStream(b).map(Item(_, b)))
+    def inA(obj: Int) = obj >= 0 && (split == 0 || obj < split)
+    def inB(obj: Int) = split == 0 || obj >= split
 
     val window = Array.fill(m)(Garbage)
     def shiftIn(item: Item): Unit = {
@@ -51,7 +65,7 @@ object StreamScheduleModel {
     while (block < blocks) {
       out += Vector.tabulate(m) { k =>
         val b = window(k)
-        if (b.block == block) Some((a(k), b.obj)) else None
+        if (b.block == block && inA(a(k)) && inB(b.obj)) Some((a(k), b.obj)) else None
       }
       if (d < m) aNext(d) = window(m - 1).obj
       val blockEnds = window(0).block == block && (window(0).obj == n - 1)
@@ -63,7 +77,9 @@ object StreamScheduleModel {
     Run(out.result(), startup)
   }
 
-  def cycles(n: Int, m: Int, readLatency: Int): Vector[Vector[Lane]] = run(n, m, readLatency).cycles
+  def cycles(n: Int, m: Int, readLatency: Int, split: Int = 0): Vector[Vector[Lane]] =
+    run(n, m, readLatency, split).cycles
 
-  def testedPairs(n: Int, m: Int, readLatency: Int): Seq[(Int, Int)] = cycles(n, m, readLatency).flatMap(_.flatten)
+  def testedPairs(n: Int, m: Int, readLatency: Int, split: Int = 0): Seq[(Int, Int)] =
+    cycles(n, m, readLatency, split).flatMap(_.flatten)
 }
