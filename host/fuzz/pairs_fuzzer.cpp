@@ -196,37 +196,41 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::size_t threads = mByte & 0x80 ? 2 : 1;
   const std::size_t cellsPerBatch = 1 + 3 * ((mByte >> 3) & 3u);
   const std::size_t batchCells = 1 + ((mByte >> 5) & 3u);
-  const std::size_t capacity = std::max<std::size_t>(2, m * (1 + in.byte() % (24 / m + 1)));
+  const std::uint8_t capacityByte = in.byte();
+  const std::size_t capacity = std::max<std::size_t>(2, m * (1 + (capacityByte & 0x7fu) % (24 / m + 1)));
+  // The stream architecture's model (bipartite chunk pairs) or the seed's (triangular ones).
+  const std::uint64_t streamReadLatency = capacityByte & 0x80u ? 4 : 0;
+  const char* const arch = streamReadLatency ? "stream" : "seed";
   const std::vector<Aabb> boxes = decodeScene(in);
 
   CpuBackend cpu;
-  ModelBackend model(m, capacity, /*runOverheadCycles=*/3, /*streamReadLatency=*/0, batchCells);
+  ModelBackend model(m, capacity, /*runOverheadCycles=*/3, streamReadLatency, batchCells);
   std::vector<Setup> setups;
   std::vector<std::optional<std::size_t>> cells{std::nullopt};
   if (cell) cells.push_back(cell);
   for (const auto& c : cells) {
     const std::string cellName = c ? std::to_string(*c) : "none";
     setups.push_back({"cpu cell " + cellName, [&cpu, c] { return std::make_unique<BroadPhase>(cpu, c); }});
-    setups.push_back({fmt::format("model m {} capacity {} cell {} batch {}/{}", m, capacity, cellName, cellsPerBatch,
-                                  batchCells),
+    setups.push_back({fmt::format("model {} m {} capacity {} cell {} batch {}/{}", arch, m, capacity, cellName,
+                                  cellsPerBatch, batchCells),
                       [&model, c, cellsPerBatch] { return std::make_unique<BroadPhase>(model, c, cellsPerBatch); }});
   }
   if (cell) {
     setups.push_back({"cpu grid cell " + std::to_string(*cell), [&cpu, cell] {
                         return std::make_unique<BroadPhase>(cpu, cell, 1, PartitionKind::UniformGrid);
                       }});
-    setups.push_back({fmt::format("model m {} capacity {} grid cell {} batch {}/{}", m, capacity, *cell,
+    setups.push_back({fmt::format("model {} m {} capacity {} grid cell {} batch {}/{}", arch, m, capacity, *cell,
                                   cellsPerBatch, batchCells),
                       [&model, cell, cellsPerBatch] {
                         return std::make_unique<BroadPhase>(model, cell, cellsPerBatch, PartitionKind::UniformGrid);
                       }});
   }
   if (threads > 1 && cell) {
-    const auto makeModel = [m, capacity, batchCells]() -> std::unique_ptr<Backend> {
-      return std::make_unique<ModelBackend>(m, capacity, 3, 0, batchCells);
+    const auto makeModel = [m, capacity, streamReadLatency, batchCells]() -> std::unique_ptr<Backend> {
+      return std::make_unique<ModelBackend>(m, capacity, 3, streamReadLatency, batchCells);
     };
-    setups.push_back({fmt::format("model m {} capacity {} cell {} threads {} batch {}/{}", m, capacity, *cell, threads,
-                                  cellsPerBatch, batchCells),
+    setups.push_back({fmt::format("model {} m {} capacity {} cell {} threads {} batch {}/{}", arch, m, capacity, *cell,
+                                  threads, cellsPerBatch, batchCells),
                       [makeModel, cell, threads, cellsPerBatch] {
                         return std::make_unique<BroadPhase>(makeModel, cell, threads, cellsPerBatch);
                       }});

@@ -16,6 +16,7 @@ AsyncBackend::AsyncBackend(const DeviceFactory& makeDevice) {
       if (!device) throw std::invalid_argument("async backend: the device factory gave no device");
       name_ = device->name();
       capacity_ = device->capacity();
+      bipartite_ = device->bipartite();
     } catch (...) {
       built.set_exception(std::current_exception());
       return;
@@ -31,7 +32,14 @@ AsyncBackend::AsyncBackend(const DeviceFactory& makeDevice) {
 AsyncBackend::~AsyncBackend() = default;
 
 std::future<BatchResult> AsyncBackend::submit(std::span<const std::span<const KeyBox>> cells) {
-  Job job{{cells.begin(), cells.end()}, {}};
+  return enqueue(Job{{cells.begin(), cells.end()}, 0, {}});
+}
+
+std::future<BatchResult> AsyncBackend::submitBipartite(std::span<const KeyBox> boxes, std::size_t split) {
+  return enqueue(Job{{boxes}, split, {}});
+}
+
+std::future<BatchResult> AsyncBackend::enqueue(Job job) {
   auto result = job.result.get_future();
   {
     const std::lock_guard lock(mutex_);
@@ -54,7 +62,12 @@ void AsyncBackend::serve(std::stop_token stop, Backend& device) {
     }
     BatchResult out;
     try {
-      device.runBatch(job.cells, out.pairs, out.cellEnds, out.stats);
+      if (job.split != 0) {
+        device.runBipartite(job.cells.front(), job.split, out.pairs, out.stats);
+        out.cellEnds.push_back(out.pairs.size());
+      } else {
+        device.runBatch(job.cells, out.pairs, out.cellEnds, out.stats);
+      }
       job.result.set_value(std::move(out));
     } catch (...) {
       job.result.set_exception(std::current_exception());

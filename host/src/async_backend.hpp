@@ -48,18 +48,24 @@ class AsyncBackend {
 
   const std::string& name() const { return name_; }
   std::size_t capacity() const { return capacity_; }
+  bool bipartite() const { return bipartite_; }
   /// Queues one hand-over of `cells` (each at most capacity() boxes).
   std::future<BatchResult> submit(std::span<const std::span<const KeyBox>> cells);
+  /// Queues one bipartite run (Backend::runBipartite), a hand-over of one cell.
+  std::future<BatchResult> submitBipartite(std::span<const KeyBox> boxes, std::size_t split);
 
  private:
   struct Job {
     std::vector<std::span<const KeyBox>> cells;
+    std::size_t split = 0;  // non-zero: one bipartite run of cells[0]
     std::promise<BatchResult> result;
   };
+  std::future<BatchResult> enqueue(Job job);
   void serve(std::stop_token stop, Backend& device);
 
   std::string name_;
   std::size_t capacity_ = 0;
+  bool bipartite_ = false;
   std::mutex mutex_;
   std::condition_variable_any jobReady_;
   std::deque<Job> jobs_;

@@ -1,15 +1,32 @@
 #include "backend.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
 namespace bpaccel {
 
-std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m) {
+std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m, std::uint64_t split) {
   if (n < 2) return 0;
-  const std::uint64_t blocks = (n - 2) / m + 1;
-  return blocks * (n - 1) - m * blocks * (blocks - 1) / 2;
+  if (split >= n) throw std::invalid_argument(fmt::format("schedule: split {} is not below n = {}", split, n));
+  const std::uint64_t lastA = split == 0 ? n - 2 : split - 1;
+  const std::uint64_t blocks = lastA / m + 1;
+  // Blocks with b*m < na - 2m jump past their prefix: 2m - 1 + nb cycles each.
+  const std::uint64_t full = split > 2 * m ? std::min(blocks, (split - 2 * m + m - 1) / m) : 0;
+  const std::uint64_t fullCycles = full * (2 * m - 1 + (n - split));
+  // The others take n - 1 - b*m: b = full .. blocks-1.
+  return fullCycles + (blocks - full) * (n - 1) - m * (blocks * (blocks - 1) / 2 - full * (full - 1) / 2);
+}
+
+void Backend::runBipartite(std::span<const KeyBox>, std::size_t, std::vector<Pair>&, RunStats&) {
+  throw std::logic_error(fmt::format("{}: no bipartite runs on this backend", name()));
+}
+
+void Backend::checkBipartite(std::size_t n, std::size_t split) const {
+  if (!bipartite()) throw std::logic_error(fmt::format("{}: no bipartite runs on this backend", name()));
+  if (split < 1 || split >= n)
+    throw std::invalid_argument(fmt::format("{}: bipartite split {} outside 1 .. n-1 (n = {})", name(), split, n));
 }
 
 void Backend::runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
@@ -35,9 +52,19 @@ ModelBackend::ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t ru
 }
 
 void ModelBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) {
-  runCell(boxes, out, stats);
+  runCell(boxes, 0, out, stats);
   stats.loadCycles += boxes.size() + 1;  // one box a cycle, then the start cycle
   stats.cycles += busyCycles(boxes.size());
+  stats.runs += 1;
+  stats.batches += 1;
+}
+
+void ModelBackend::runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                                RunStats& stats) {
+  checkBipartite(boxes.size(), split);
+  runCell(boxes, split, out, stats);
+  stats.loadCycles += boxes.size() + 1;
+  stats.cycles += busyCycles(boxes.size(), split);
   stats.runs += 1;
   stats.batches += 1;
 }
@@ -50,7 +77,7 @@ void ModelBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std:
   for (std::size_t first = 0; first < cells.size(); first += batchCells_) {
     const auto batch = cells.subspan(first, std::min(batchCells_, cells.size() - first));
     for (const auto& cell : batch) {
-      runCell(cell, out, stats);
+      runCell(cell, 0, out, stats);
       cellEnds.push_back(out.size());
     }
     // The cycles come from the batch's timeline, not from its cells one by one.
@@ -60,18 +87,24 @@ void ModelBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std:
   }
 }
 
-void ModelBackend::runCell(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) const {
+void ModelBackend::runCell(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                           RunStats& stats) const {
   const std::size_t n = boxes.size();
   if (n > capacity_) throw std::length_error(fmt::format("model: {} boxes exceed the capacity {}", n, capacity_));
   const std::size_t before = out.size();
   // Block b, window start s: lane k tests (b*m + k, s + k) while s + k < n,
   // exactly as the hardware's sequencer issues it. A beat is one cycle with a hit.
+  // A bipartite run (split = na) runs the A blocks, from s = max(base + 1,
+  // na - 2m + 1) (where the stream's jump lands), its lanes k testing A
+  // objects base + k < na against B objects s + k >= na.
   std::uint64_t beats = 0;
-  for (std::size_t base = 0; n >= 2 && base + 2 <= n; base += m_) {
-    for (std::size_t s = base + 1; s < n; ++s) {
+  const std::size_t lastA = split == 0 ? n - 2 : split - 1;
+  for (std::size_t base = 0; n >= 2 && base <= lastA; base += m_) {
+    const std::size_t first = split > 2 * m_ ? std::max(base + 1, split - 2 * m_ + 1) : base + 1;
+    for (std::size_t s = first; s < n; ++s) {
       bool hit = false;
-      const std::size_t lanes = std::min(m_, n - s);
-      for (std::size_t k = 0; k < lanes; ++k) {
+      const std::size_t lanes = std::min({m_, n - s, lastA + 1 - base + (split == 0)});
+      for (std::size_t k = s < split ? split - s : 0; k < lanes; ++k) {
         if (overlaps(boxes[base + k], boxes[s + k])) {
           out.emplace_back(static_cast<std::uint32_t>(base + k), static_cast<std::uint32_t>(s + k));
           hit = true;
@@ -80,7 +113,7 @@ void ModelBackend::runCell(std::span<const KeyBox> boxes, std::vector<Pair>& out
       beats += hit;
     }
   }
-  stats.issueCycles += scheduleIssueCycles(n, m_);
+  stats.issueCycles += scheduleIssueCycles(n, m_, split);
   stats.hits += out.size() - before;
   stats.boxesSent += n;
   stats.beatsReceived += beats;
@@ -93,8 +126,8 @@ std::uint64_t ModelBackend::startupCycles(std::uint64_t n) const {
   return streamReadLatency_;
 }
 
-std::uint64_t ModelBackend::busyCycles(std::uint64_t n) const {
-  return n < 2 ? 0 : startupCycles(n) + scheduleIssueCycles(n, m_) + overhead_;
+std::uint64_t ModelBackend::busyCycles(std::uint64_t n, std::uint64_t split) const {
+  return n < 2 ? 0 : startupCycles(n) + scheduleIssueCycles(n, m_, split) + overhead_;
 }
 
 void ModelBackend::batchCycles(std::span<const std::span<const KeyBox>> batch, RunStats& stats) const {

@@ -31,13 +31,26 @@ class Backend {
   /// cell is its own run (and so its own batch).
   virtual void runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
                         std::vector<std::size_t>& cellEnds, RunStats& stats);
+  /// Whether runBipartite() exists here (the stream architecture's device and its model).
+  virtual bool bipartite() const { return false; }
+  /// One bipartite run (one run, one batch): appends only the overlapping
+  /// pairs (i, j) with i < split <= j, for 1 <= split < boxes.size(). Where
+  /// bipartite() is false it throws std::logic_error.
+  virtual void runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                            RunStats& stats);
+
+ protected:
+  /// For implementations of runBipartite: throws unless bipartite() and 1 <= split < n.
+  void checkBipartite(std::size_t n, std::size_t split) const;
 };
 
 /// The accelerator's schedule in closed form: issue cycles of one run of n
 /// objects with m lanes, sum over blocks b of (n - 1 - b*m); 0 for n < 2.
-/// Must equal bpaccel.Schedule.issueCycles in the generator (tests compare
-/// it with the Verilated hardware's own counter).
-std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m);
+/// A bipartite run (split = na > 0) runs the blocks b*m <= na-1 only, in
+/// min(n - 1 - b*m, 2m - 1 + n - na) cycles each. Must equal
+/// bpaccel.Schedule.issueCycles in the generator (tests compare it with the
+/// Verilated hardware's own counter).
+std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m, std::uint64_t split = 0);
 
 /// Fast C++ model of the accelerator: the same schedule, pairs and cycle
 /// counts (loads included) as the RTL driven by a host that loads one box a
@@ -59,14 +72,18 @@ class ModelBackend final : public Backend {
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
   void runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
                 std::vector<std::size_t>& cellEnds, RunStats& stats) override;
+  /// The stream architecture's (streamReadLatency > 0); the seed's hardware refuses a split.
+  bool bipartite() const override { return streamReadLatency_ != 0; }
+  void runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                    RunStats& stats) override;
 
  private:
-  /// One cell's pairs and counters, without counting it as a run; its load
-  /// cycles and cycles depend on the hand-over (run, or batchCycles).
-  void runCell(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) const;
+  /// One cell's pairs and counters (split 0: all pairs), without counting it
+  /// as a run; its load cycles and cycles depend on the hand-over (run, or batchCycles).
+  void runCell(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats) const;
   /// Cycles before a run of n objects issues (0 for the seed), and all its busy cycles.
   std::uint64_t startupCycles(std::uint64_t n) const;
-  std::uint64_t busyCycles(std::uint64_t n) const;
+  std::uint64_t busyCycles(std::uint64_t n, std::uint64_t split = 0) const;
   /// One hardware batch's load and run cycles, cell by cell on the device's timeline.
   void batchCycles(std::span<const std::span<const KeyBox>> batch, RunStats& stats) const;
 

@@ -60,10 +60,12 @@ struct BroadPhase::Worker {
     std::vector<KeyBox> boxes;
     std::vector<std::span<const KeyBox>> cellSpans;  // what the backend gets, made at the hand-over
     std::vector<std::span<const std::uint32_t>> cellItems;
+    std::size_t bipartiteSplit = 0;  // non-zero: one bipartite run of its only cell (Backend::runBipartite)
     void clear() {
       cells.clear();
       items.clear();
       boxes.clear();
+      bipartiteSplit = 0;
     }
   };
   Batch filling;   // the batch being filled
@@ -79,6 +81,9 @@ struct BroadPhase::Worker {
   // `below`: the cell's below() bits (with `lasting` only; empty: the region decides).
   void submit(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
               std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep, bool lasting);
+  // A chunk pair as one bipartite hand-over: only pairs across `split`.
+  void submitBipartite(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, const Cell* region,
+                       std::size_t split);
   void runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
               std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep);
   void flush();   // hands the batch being filled over, if any
@@ -105,6 +110,7 @@ struct BroadPhase::Worker {
   void keptUntil(const Pair* end) { out.resize(static_cast<std::size_t>(end - out.data())); }
   void processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
                    std::span<const std::uint8_t> below, const Cell* region, std::size_t capacity, bool lasting);
+  bool bipartite() const { return async ? async->bipartite() : backend->bipartite(); }
 };
 
 /// The threads of a multi-threaded BroadPhase: an arena of its own, so the
@@ -314,9 +320,13 @@ void BroadPhase::finishCells(std::vector<Pair>& out) {
 }
 
 // A cell within capacity is one run. A larger one is cut into k chunks of at
-// most capacity/2 boxes; chunks p < q run together and keep their cross
-// pairs, and each chunk's inside pairs are kept from exactly one run: chunk
-// p from run (p, p+1), the last chunk from run (k-2, k-1).
+// most capacity/2 boxes. Where the backend runs bipartite runs, each chunk
+// runs alone for its inside pairs and each two chunks p < q run as one
+// bipartite run for their cross pairs, so every pair is tested once.
+// Otherwise chunks p < q run together and keep their cross pairs, and each
+// chunk's inside pairs are kept from exactly one run: chunk p from run
+// (p, p+1), the last chunk from run (k-2, k-1); those runs test every
+// chunk's inside pairs again in every pair it is in.
 void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
                                      std::span<const KeyBox> packed, std::span<const std::uint8_t> below,
                                      const Cell* region, std::size_t capacity, bool lasting) {
@@ -327,13 +337,21 @@ void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<con
   }
   const std::size_t chunk = capacity / 2;
   const std::size_t k = (items.size() + chunk - 1) / chunk;
+  const auto chunkOf = [&](std::size_t p) { return items.subspan(p * chunk, std::min(chunk, items.size() - p * chunk)); };
+  const bool acrossOnly = bipartite();
+  if (acrossOnly)
+    for (std::size_t p = 0; p < k; ++p)
+      if (chunkOf(p).size() >= 2) submit(keys, chunkOf(p), {}, {}, region, chunkOf(p).size(), kFirstInside, false);
   std::vector<std::uint32_t> pairItems;  // rare path (cell beyond capacity): allocation is fine here
   for (std::size_t p = 0; p < k; ++p) {
     for (std::size_t q = p + 1; q < k; ++q) {
-      const auto first = items.subspan(p * chunk, std::min(chunk, items.size() - p * chunk));
-      const auto second = items.subspan(q * chunk, std::min(chunk, items.size() - q * chunk));
+      const auto first = chunkOf(p), second = chunkOf(q);
       pairItems.assign(first.begin(), first.end());
       pairItems.insert(pairItems.end(), second.begin(), second.end());
+      if (acrossOnly) {
+        submitBipartite(keys, pairItems, region, first.size());
+        continue;
+      }
       int keep = kCross;
       if (q == p + 1) keep |= kFirstInside;
       if (p == k - 2 && q == k - 1) keep |= kSecondInside;
@@ -373,6 +391,23 @@ void BroadPhase::Worker::submit(std::span<const KeyBox> keys, std::span<const st
   if (filling.cells.size() >= cellsPerBatch) flush();
 }
 
+void BroadPhase::Worker::submitBipartite(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
+                                         const Cell* region, std::size_t split) {
+  flush();  // a hand-over of its own, after the cells before it
+  PendingCell cell;
+  if (region) cell.region = *region;
+  cell.hasRegion = region != nullptr;
+  cell.splitAt = split;
+  cell.keep = kCross;
+  cell.copied = true;
+  cell.count = items.size();
+  filling.items.assign(items.begin(), items.end());
+  for (const std::uint32_t id : items) filling.boxes.push_back(keys[id]);
+  filling.cells.push_back(cell);
+  filling.bipartiteSplit = split;
+  flush();
+}
+
 void BroadPhase::Worker::flush() {
   if (filling.cells.empty()) return;
   filling.cellSpans.clear();
@@ -385,8 +420,16 @@ void BroadPhase::Worker::flush() {
   if (!async) {
     local.clear();
     cellEnds.clear();
-    handOver([&](RunStats& runStats) { backend->runBatch(filling.cellSpans, local, cellEnds, runStats); },
-             [&] { decodeBatch(filling, local, cellEnds); });
+    handOver(
+        [&](RunStats& runStats) {
+          if (filling.bipartiteSplit == 0) {
+            backend->runBatch(filling.cellSpans, local, cellEnds, runStats);
+          } else {
+            backend->runBipartite(filling.cellSpans.front(), filling.bipartiteSplit, local, runStats);
+            cellEnds.push_back(local.size());
+          }
+        },
+        [&] { decodeBatch(filling, local, cellEnds); });
     filling.clear();
     return;
   }
@@ -396,7 +439,9 @@ void BroadPhase::Worker::flush() {
   // device holds stay valid) and `filling` takes the decoded one's storage.
   RunRecord record;
   record.readySeconds = seconds(frameStart, Clock::now()) - backendSeconds;
-  std::future<BatchResult> result = async->submit(filling.cellSpans);
+  std::future<BatchResult> result = filling.bipartiteSplit == 0
+                                        ? async->submit(filling.cellSpans)
+                                        : async->submitBipartite(filling.cellSpans.front(), filling.bipartiteSplit);
   try {
     collect();
   } catch (...) {

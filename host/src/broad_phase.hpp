@@ -37,8 +37,10 @@ enum class HandOvers { Synchronous, Asynchronous };
 
 /// Finds every overlapping pair of a scene exactly once. Without a cell size
 /// the scene is one cell. A cell larger than the backend's capacity is
-/// covered in chunks of capacity/2 boxes: every two chunks run together, and
-/// each pair is kept from exactly one of those runs.
+/// covered in chunks of capacity/2 boxes: where the backend runs bipartite
+/// runs (Backend::bipartite), each chunk runs alone and every two chunks run
+/// as one bipartite run, so each pair is tested once; otherwise every two
+/// chunks run together, and each pair is kept from exactly one of those runs.
 ///
 /// The scene is partitioned into cells by a k-d tree (the default) or a
 /// uniform grid (PartitionKind). The cells go to the backend as the

@@ -73,6 +73,7 @@ RtlBackend::RtlBackend(std::function<bool(std::uint64_t)> consumerReady)
   check("batch cells", top_->io_info_batchCells, BPACCEL_BATCH_CELLS);
   check("cell tag width", top_->io_info_cellTagWidth, BPACCEL_CELL_TAG_WIDTH);
   check("batch overlaps loads", top_->io_info_batchOverlapsLoads, BPACCEL_BATCH_OVERLAPS_LOADS);
+  check("bipartite runs", top_->io_info_bipartiteRuns, BPACCEL_BIPARTITE_RUNS);
 }
 
 RtlBackend::~RtlBackend() { top_->final(); }
@@ -82,6 +83,7 @@ std::size_t RtlBackend::lanes() { return BPACCEL_M; }
 std::size_t RtlBackend::batchCells() { return BPACCEL_BATCH_CELLS; }
 std::uint64_t RtlBackend::runOverheadCycles() { return BPACCEL_RUN_OVERHEAD_CYCLES; }
 std::string RtlBackend::architecture() { return BPACCEL_ARCH; }
+bool RtlBackend::bipartite() const { return BPACCEL_BIPARTITE_RUNS != 0; }
 
 ModelBackend modelOfBuiltHardware() {
   return ModelBackend(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES, BPACCEL_READ_LATENCY,
@@ -113,12 +115,23 @@ void RtlBackend::reset() {
 }
 
 void RtlBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) {
+  runGuarded(boxes, 0, out, stats);
+}
+
+void RtlBackend::runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                              RunStats& stats) {
+  checkBipartite(boxes.size(), split);
+  runGuarded(boxes, split, out, stats);
+}
+
+void RtlBackend::runGuarded(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                            RunStats& stats) {
   const std::size_t n = boxes.size();
   if (n > capacity())
     throw std::length_error(fmt::format("rtl: {} boxes exceed the hardware capacity {}", n, capacity()));
   const std::size_t before = out.size();
   try {
-    runOnHardware(boxes, out, stats);
+    runOnHardware(boxes, split, out, stats);
   } catch (...) {
     // A hang or a hardware error leaves the device mid-run: reset it so the
     // next batch starts from an idle accelerator, and drop this run's partial pairs.
@@ -128,7 +141,8 @@ void RtlBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunS
   }
 }
 
-void RtlBackend::runOnHardware(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) {
+void RtlBackend::runOnHardware(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                               RunStats& stats) {
   const std::size_t n = boxes.size();
   VBroadPhaseAccel& top = *top_;
 
@@ -142,7 +156,8 @@ void RtlBackend::runOnHardware(std::span<const KeyBox> boxes, std::vector<Pair>&
   top.io_load_valid = 0;
 
   top.io_start_valid = 1;
-  top.io_start_bits = static_cast<std::uint32_t>(n);
+  top.io_start_bits_count = static_cast<std::uint32_t>(n);
+  top.io_start_bits_split = static_cast<std::uint32_t>(split);
   settle();
   if (!top.io_start_ready) throw std::runtime_error("rtl: start not accepted while idle");
   tick();
@@ -150,7 +165,7 @@ void RtlBackend::runOnHardware(std::span<const KeyBox> boxes, std::vector<Pair>&
 
   // Play the consumer until the run is over. A bound far above any legal run
   // turns a hang into an error.
-  const std::uint64_t issue = scheduleIssueCycles(n, BPACCEL_M);
+  const std::uint64_t issue = scheduleIssueCycles(n, BPACCEL_M, split);
   const std::uint64_t limit = 64 * (issue + 1000);
   const std::size_t before = out.size();
   std::uint64_t beats = 0;
@@ -226,7 +241,10 @@ void RtlBackend::batchOnHardware(std::span<const std::span<const KeyBox>> cells,
     }
     const bool countOffered = nextCount < cells.size();
     top.io_cells_valid = countOffered;
-    if (countOffered) top.io_cells_bits = static_cast<std::uint32_t>(cells[nextCount].size());
+    if (countOffered) {
+      top.io_cells_bits_count = static_cast<std::uint32_t>(cells[nextCount].size());
+      top.io_cells_bits_split = 0;  // the host batches triangular cells; bipartite runs go alone
+    }
     const bool boxOffered = cell < cells.size();
     top.io_load_valid = boxOffered;
     if (boxOffered)

@@ -36,6 +36,11 @@ class RtlBackend final : public Backend {
   /// `cellEnds` or `stats`.
   void runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
                 std::vector<std::size_t>& cellEnds, RunStats& stats) override;
+  /// BPACCEL_BIPARTITE_RUNS: the stream architecture's hardware.
+  bool bipartite() const override;
+  /// One start with the split; the same reset on failure as run().
+  void runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                    RunStats& stats) override;
 
   static std::size_t lanes();
   static std::size_t batchCells();
@@ -47,7 +52,8 @@ class RtlBackend final : public Backend {
   void settle();  // evaluate combinational outputs for the current inputs
   void tick();    // one rising clock edge
   void reset();
-  void runOnHardware(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats);
+  void runGuarded(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats);
+  void runOnHardware(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats);
   void batchOnHardware(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
                        std::vector<std::size_t>& cellEnds, RunStats& stats);
 

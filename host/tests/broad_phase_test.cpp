@@ -51,12 +51,82 @@ TEST(BroadPhase, ModelAndCpuAreExactOnAdversarialScenesForEveryCellSize) {
 
 TEST(BroadPhase, CoversCellsAboveTheCapacityInChunksExactly) {
   // A tiny capacity forces chunking of cells the tree cannot split and of whole scenes.
-  for (std::size_t capacity : {2u, 4u, 6u, 16u}) {
-    ModelBackend small(2, capacity, 5);
-    for (const auto& [name, boxes] : adversarialScenes(70, 5))
-      for (const auto& cell : {std::optional<std::size_t>{}, std::optional<std::size_t>{4},
-                               std::optional<std::size_t>{40}})
-        expectExact(small, boxes, cell, name + " capacity " + std::to_string(capacity));
+  // The seed's model chunks into triangular chunk-pair runs, the stream's into bipartite ones.
+  for (std::size_t capacity : {2u, 4u, 6u, 16u})
+    for (std::uint64_t streamReadLatency : {0u, 4u}) {
+      ModelBackend small(2, capacity, 5, streamReadLatency);
+      for (const auto& [name, boxes] : adversarialScenes(70, 5))
+        for (const auto& cell : {std::optional<std::size_t>{}, std::optional<std::size_t>{4},
+                                 std::optional<std::size_t>{40}})
+          expectExact(small, boxes, cell,
+                      name + " capacity " + std::to_string(capacity) + (streamReadLatency ? " stream" : " seed"));
+    }
+}
+
+TEST(BroadPhase, CellsAboveTheCapacityRunAsBipartiteChunkPairsTestingEachPairOnce) {
+  // 300 identical boxes: one leaf, ten chunks of 32 (the last 12).
+  const std::vector<Aabb> same(300, box(1, 1, 1, 2, 2, 2));
+  const std::size_t m = 4, capacity = 64, chunk = 32, k = 10;
+  std::vector<std::size_t> sizes;
+  for (std::size_t first = 0; first < same.size(); first += chunk) sizes.push_back(std::min(chunk, same.size() - first));
+  ASSERT_EQ(sizes.size(), k);
+  std::uint64_t bipartiteIssue = 0, triangularIssue = 0;
+  for (std::size_t p = 0; p < k; ++p) {
+    bipartiteIssue += scheduleIssueCycles(sizes[p], m);
+    for (std::size_t q = p + 1; q < k; ++q) {
+      bipartiteIssue += scheduleIssueCycles(sizes[p] + sizes[q], m, sizes[p]);
+      triangularIssue += scheduleIssueCycles(sizes[p] + sizes[q], m);
+    }
+  }
+  ModelBackend stream(m, capacity, 3, 4), seed(m, capacity, 3);
+  for (Backend* backend : {static_cast<Backend*>(&stream), static_cast<Backend*>(&seed)}) {
+    BroadPhase bp(*backend, 16);
+    std::vector<Pair> pairs;
+    bp.findPairs(same, pairs);
+    EXPECT_EQ(pairs.size(), 300u * 299u / 2u);
+    EXPECT_EQ(sorted(pairs), bruteForce(same));
+    if (backend->bipartite()) {
+      EXPECT_EQ(bp.stats().runs, k + k * (k - 1) / 2);  // each chunk alone, each two across
+      EXPECT_EQ(bp.stats().issueCycles, bipartiteIssue);
+    } else {
+      EXPECT_EQ(bp.stats().runs, k * (k - 1) / 2);  // each two chunks together
+      EXPECT_EQ(bp.stats().issueCycles, triangularIssue);
+    }
+  }
+  EXPECT_LT(bipartiteIssue, triangularIssue * 7 / 10);  // small chunks: the 2m - 1 prefix per block weighs more
+  // Asynchronous hand-overs run the bipartite runs in the same order with the same cycles.
+  BroadPhase sync(stream, 16, 5);
+  BroadPhase async([&] { return std::make_unique<ModelBackend>(m, capacity, 3, 4); }, 16, 1, 5,
+                   PartitionKind::KdTree, HandOvers::Asynchronous);
+  std::vector<Pair> expected, pairs;
+  sync.findPairs(same, expected);
+  async.findPairs(same, pairs);
+  EXPECT_EQ(pairs, expected);
+  EXPECT_EQ(async.stats().deviceCycles(), sync.stats().deviceCycles());
+  EXPECT_EQ(async.runs().size(), sync.runs().size());
+}
+
+TEST(ModelBackend, BipartiteRunsTestOnlyAcrossTheSplitAndRefuseABadSplit) {
+  ModelBackend stream(3, 64, 3, 4), seed(3, 63, 3);
+  const auto boxes = adversarialScenes(40, 4).at(1).second;  // clusters: many hits
+  std::vector<KeyBox> keys;
+  toKeys(boxes, keys);
+  std::vector<Pair> pairs;
+  RunStats stats;
+  EXPECT_THROW(seed.runBipartite(keys, 5, pairs, stats), std::logic_error);
+  EXPECT_THROW(stream.runBipartite(keys, 0, pairs, stats), std::invalid_argument);
+  EXPECT_THROW(stream.runBipartite(keys, 40, pairs, stats), std::invalid_argument);
+  EXPECT_TRUE(pairs.empty());
+  for (std::size_t split = 1; split < 40; ++split) {
+    pairs.clear();
+    stats = {};
+    stream.runBipartite(keys, split, pairs, stats);
+    std::vector<Pair> across;
+    for (const Pair& p : bruteForce(boxes))
+      if (p.first < split && p.second >= split) across.push_back(p);
+    EXPECT_EQ(sorted(pairs), across) << "split " << split;
+    EXPECT_EQ(stats.issueCycles, scheduleIssueCycles(40, 3, split)) << "split " << split;
+    EXPECT_EQ(stats.cycles, 4 + stats.issueCycles + 3) << "split " << split;
   }
 }
 
@@ -169,7 +239,14 @@ TEST(ScheduleIssueCycles, MatchesThePlainSumOverBlocks) {
       std::uint64_t sum = 0;
       for (std::uint64_t b = 0; n >= 2 && b * m <= n - 2; ++b) sum += n - 1 - b * m;
       ASSERT_EQ(scheduleIssueCycles(n, m), sum) << "m=" << m << " n=" << n;
+      // Bipartite: the A blocks only, each until lane 0 reaches n-1 or past its prefix's 2m-1 and B.
+      for (std::uint64_t split = 1; split < n; ++split) {
+        std::uint64_t bipartite = 0;
+        for (std::uint64_t b = 0; b * m <= split - 1; ++b) bipartite += std::min(n - 1 - b * m, 2 * m - 1 + n - split);
+        ASSERT_EQ(scheduleIssueCycles(n, m, split), bipartite) << "m=" << m << " n=" << n << " split=" << split;
+      }
     }
+  EXPECT_THROW(scheduleIssueCycles(10, 4, 10), std::invalid_argument);
 }
 
 TEST(AllPairsKernel, SimdGivesTheScalarPairsInTheSameOrderForEverySize) {

@@ -159,7 +159,51 @@ TEST(RtlBackend, IsExactThroughTheKdTreeAndAcrossChunks) {
   bp.findPairs(many, pairs);
   EXPECT_EQ(pairs.size(), many.size() * (many.size() - 1) / 2);
   EXPECT_EQ(sorted(pairs), bruteForce(many));
-  EXPECT_EQ(bp.stats().runs, 3u);  // three chunks of capacity/2: runs (0,1), (0,2), (1,2)
+  // Three chunks of capacity/2: with bipartite runs, each chunk alone and the
+  // pairs (0,1), (0,2), (1,2) across; else runs (0,1), (0,2), (1,2) of both chunks.
+  EXPECT_EQ(bp.stats().runs, BPACCEL_BIPARTITE_RUNS ? 6u : 3u);
+}
+
+TEST(RtlBackend, BipartiteRunsAgreeWithTheModelAndTestOnlyAcrossTheSplit) {
+  RtlBackend rtl;
+  ModelBackend model = modelOfBuiltHardware();
+  ASSERT_EQ(rtl.bipartite(), BPACCEL_BIPARTITE_RUNS != 0);
+  ASSERT_EQ(model.bipartite(), rtl.bipartite());
+  const auto keys = keysOf(adversarialScenes(3 * BPACCEL_M + 5, 21).at(1).second);  // clusters: many hits
+  std::vector<Pair> pairs;
+  RunStats stats;
+  if (!rtl.bipartite()) {
+    EXPECT_THROW(rtl.runBipartite(keys, 3, pairs, stats), std::logic_error);
+    EXPECT_THROW(model.runBipartite(keys, 3, pairs, stats), std::logic_error);
+    return;
+  }
+  EXPECT_THROW(rtl.runBipartite(keys, 0, pairs, stats), std::invalid_argument);
+  EXPECT_THROW(rtl.runBipartite(keys, keys.size(), pairs, stats), std::invalid_argument);
+  EXPECT_TRUE(pairs.empty());
+  std::mt19937 rng(8);
+  std::vector<std::size_t> sizes = {2, 3, BPACCEL_M + 1, BPACCEL_M + 2, 2 * BPACCEL_M + 3, 5 * BPACCEL_M + 1};
+  for (int t = 0; t < 4; ++t) sizes.push_back(2 + rng() % 300);
+  for (std::size_t n : sizes)
+    for (std::size_t split : {std::size_t{1}, n / 2, n - 1, std::size_t{1 + rng() % (n - 1)}, std::min<std::size_t>(n - 1, 2 * BPACCEL_M + 1)}) {
+      if (split < 1 || split >= n) continue;
+      const auto boxes = adversarialScenes(n, static_cast<unsigned>(n + split)).at(1).second;
+      const auto label = fmt::format("n={} split={}", n, split);
+      const auto k = keysOf(boxes);
+      BothRuns r;
+      rtl.runBipartite(k, split, r.fromRtl, r.rtlStats);
+      model.runBipartite(k, split, r.fromModel, r.modelStats);
+      EXPECT_EQ(r.fromRtl, r.fromModel) << label;  // same pairs, in the same order
+      std::vector<Pair> across;
+      for (const Pair& p : bruteForce(boxes))
+        if (p.first < split && p.second >= split) across.push_back(p);
+      EXPECT_EQ(sorted(r.fromRtl), across) << label;
+      EXPECT_EQ(r.rtlStats.issueCycles, scheduleIssueCycles(n, BPACCEL_M, split)) << label;
+      EXPECT_EQ(r.rtlStats.cycles, r.modelStats.cycles) << label;
+      EXPECT_EQ(r.rtlStats.loadCycles, r.modelStats.loadCycles) << label;
+      EXPECT_EQ(r.rtlStats.beatsReceived, r.modelStats.beatsReceived) << label;
+      EXPECT_EQ(r.rtlStats.cycles, BPACCEL_READ_LATENCY + r.rtlStats.issueCycles + BPACCEL_RUN_OVERHEAD_CYCLES)
+          << label;
+    }
 }
 
 TEST(RtlBackend, IsExactThroughTheUniformGridAndAcrossChunks) {
