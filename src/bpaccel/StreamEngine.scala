@@ -150,7 +150,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // run's jump target is base+2m, the next object anyway.
   val rAtJump     = Reg(Bool())               // rObj is the prefix's last object, base+2m-1
   val rBeforeJump = Reg(UInt(p.countWidth.W)) // base+2m-2
-  val rJumpTo     = Reg(UInt(p.countWidth.W)) // max(base+2m, na)
+  val rJumpTo     = Reg(UInt(p.indexWidth.W)) // max(base+2m, na): read only while below n, so an index
   when(readEvent) {
     when(!rBlockEnd) {
       rObj      := Mux(rAtJump, rJumpTo, rObj + 1.U)
@@ -169,7 +169,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       rHasNextBlock := rALeft >= (2 * m).U
       rAtJump       := (m == 1).B
       rBeforeJump   := rBase + (3 * m - 2).U
-      rJumpTo       := maxOf(rBase + (3 * m).U, runSplit)
+      rJumpTo       := maxOf(rBase + (3 * m).U, runSplit)(p.indexWidth - 1, 0)
     } // past the last block the stream is never compared: hold
   }
   // readsNeverMeetWrites: while a run reads its bank, boxes are written only
@@ -469,7 +469,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     rHasNextBlock := lastA >= m.U // then longBlock: n - 2 >= lastA >= m
     rAtJump       := (m == 2).B // object m+1 = 2m-1 ends the prefix
     rBeforeJump   := (2 * m - 2).U
-    rJumpTo       := jumpTo0
+    rJumpTo       := jumpTo0(p.indexWidth - 1, 0)
   }
   when(io.launch.valid) { readCredits := readDepth.U }
 
