@@ -39,6 +39,12 @@ import chisel3.util._
   * by d lanes (Engine.emit), so the beats are the schedule's exactly.
   * Runs of more than one block have n >= m + 2 objects, so d = 0 for them.
   *
+  * Bipartite runs (split na > 0: only objects 0 .. na-1 against na .. n-1)
+  * keep this shape: blocks run for the A objects alone, and a block's
+  * stream jumps from its first 2m-1 objects (which still carry the next A
+  * block past the top lane) to max(base+2m, na); lanes whose B object is
+  * in A, or whose A object is past na-1, are masked (see Schedule).
+  *
   * Startup after the start: the first readLatency reads travel to the
   * window's entry. Pipeline: comparator register, AND register.
   */
