@@ -373,7 +373,11 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   val leftIsOne          = Reg(Bool()) // left == 1
   val blockLeftIsM       = Reg(Bool()) // blockLeft == m
   val aLeftAtLeast2m     = Reg(Bool()) // aLeft >= 2m
-  when(active) {
+  // The cycle after an accepted start, which sets the registers that
+  // depend on block 0's length (see the start below); read from the next
+  // cycle on, when no issue has come yet (readLatency >= 2).
+  val settling = RegNext(io.prepare.valid, false.B)
+  when(active && !settling) {
     assert(laneTop === left + headOffset && aTop === aLeft + headOffset && (headOffset === 0.U || !hasNextBlock),
       "the lanes' offset does not match the run")
     assert(s === nMinus1 - left, "the window's start does not match its count of cycles left")
@@ -435,44 +439,62 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // decoded error checks (the launch) reach only the flags below, not all of
   // these enables (stream m = 32's critical path).
   assert(!io.launch.valid || (io.prepare.valid && io.prepare.bits.count === io.launch.bits), "a launch without its start")
+  // At most one add or compare of the start's count and split per register
+  // here: the start's bits come through the batch front end's multiplexer,
+  // and block 0's length min(n-2, 2m-2+nb) computed in the start's cycle
+  // took bipartite runs to stream m = 64's critical path (70.0 MHz: batch
+  // active -> count - split -> min -> laneTop, four carry chains). So
+  // the registers only the first issue reads take it in the next cycle,
+  // `settling`, from registers.
+  val bigSplit = Reg(Bool()) // split > 2m: block 0's stream jumps, and it takes 2m-2+nb cycles after its first
+  when(settling) {
+    val left0 = Mux(bigSplit, bipartiteLeft, blockLeft) // min(n-2, 2m-2+nb)
+    s         := nMinus1 - left0
+    left      := left0
+    laneTop   := left0 + headOffset
+    leftIsOne := left0 === 1.U
+  }
   when(io.prepare.valid) {
     val count = io.prepare.bits.count // >= 2 when it launches
     val split = io.prepare.bits.split // 0, or 1 .. count-1 when it launches
     val bipartite = split =/= 0.U
-    val lastA     = Mux(bipartite, split - 1.U, count - 2.U)
-    val bipLeft   = (2 * m - 2).U +& (count - split)
-    val left0     = minOf(count - 2.U, bipLeft) // block 0's cycles after its first
+    val jumps     = split > (2 * m).U
+    val nb        = count - split // count for a triangular run
     runSplit      := split
-    bipartiteLeft := bipLeft
+    bigSplit      := jumps
+    bipartiteLeft := nb +& (2 * m - 2).U
     splitLane     := Mux(bipartite, split + io.headPad, 0.U)
     primeLeft := p.readLatency.U
     base      := 0.U
-    s         := count - 1.U - left0
     nMinus1   := count - 1.U
-    left      := left0
     blockLeft := count - 2.U
-    aLeft     := lastA
+    aLeft     := Mux(bipartite, split - 1.U, count - 2.U) // lastA
     headOffset := io.headPad
-    laneTop    := left0 + io.headPad
-    aTop       := lastA + io.headPad
-    leftIsOne          := left0 === 1.U
+    // lastA + d: headPad - 1 and - 2 come from the loader's register, not from the start.
+    val pad = io.headPad.pad(p.countWidth)
+    aTop       := Mux(bipartite, split + (pad - 1.U), count + (pad - 2.U))
     blockLeftIsM       := count === (m + 2).U
-    aLeftAtLeast2m     := lastA >= (2 * m).U
-    blockEndNext     := count === 2.U // left0 == 0
-    hasNextBlockNext := lastA >= (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 1 else 0)).U
+    aLeftAtLeast2m     := Mux(bipartite, jumps, count >= (2 * m + 2).U)
+    blockEndNext     := count === 2.U // block 0 ends at once: left0 == 0
+    hasNextBlockNext := Mux(bipartite, split > (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 1 else 0)).U,
+      count >= (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 3 else 2)).U) // lastA >= m
     captureNext := 1.U
     rBase      := 0.U
     rBlockLeft := count - 2.U
-    rALeft     := lastA
+    rALeft     := Mux(bipartite, split - 1.U, count - 2.U)
     // R[m], block 0's stream object m: object m+1 while m+1 lies in its
     // prefix (m >= 2), else the jump's target. Without it (n < m + 2) no
     // later block exists and the stream past block 0 is never compared.
     val longBlock = count >= (m + 2).U
-    val jumpTo0   = maxOf((2 * m).U, split)
+    val jumpTo0   = Mux(jumps, split, (2 * m).U) // max(2m, split)
     rObj  := Mux(longBlock, (if (m >= 2) (m + 1).U else jumpTo0), 0.U)
-    rLeft := Mux(longBlock, left0 - m.U, 0.U)
-    rBlockEnd     := !longBlock || left0 === m.U
-    rHasNextBlock := lastA >= m.U // then longBlock: n - 2 >= lastA >= m
+    // Objects after R[m] in block 0's stream: left0 - m.
+    val jumpLeft = if (m >= 2) nb + (m - 2).U else nb - 1.U
+    rLeft := Mux(longBlock, Mux(jumps, jumpLeft, count - (m + 2).U), 0.U)
+    // ... which is 0 for n = m + 2 and, at m = 1, for a jump to the last object.
+    val jumpEndsBlock = if (m == 1) jumps && nb === 1.U else false.B
+    rBlockEnd     := !longBlock || (!jumps && count === (m + 2).U) || jumpEndsBlock
+    rHasNextBlock := Mux(bipartite, split > m.U, longBlock) // lastA >= m
     rAtJump       := (m == 2).B // object m+1 = 2m-1 ends the prefix
     rBeforeJump   := (2 * m - 2).U
     rJumpTo       := jumpTo0(p.indexWidth - 1, 0)
