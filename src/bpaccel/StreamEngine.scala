@@ -445,13 +445,17 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // took bipartite runs to stream m = 64's critical path (70.0 MHz: batch
   // active -> count - split -> min -> laneTop, four carry chains). So
   // the registers only the first issue reads take it in the next cycle,
-  // `settling`, from registers.
+  // `settling`, from registers; so does aTop = lastA + d. (Written as
+  // count + (headPad - 2) in the start's cycle, firtool narrowed
+  // headPad - 2 to five bits, so it never wrapped: the host's Verilog
+  // broke where ChiselTest's passed.)
   val bigSplit = Reg(Bool()) // split > 2m: block 0's stream jumps, and it takes 2m-2+nb cycles after its first
   when(settling) {
     val left0 = Mux(bigSplit, bipartiteLeft, blockLeft) // min(n-2, 2m-2+nb)
     s         := nMinus1 - left0
     left      := left0
     laneTop   := left0 + headOffset
+    aTop      := aLeft + headOffset
     leftIsOne := left0 === 1.U
   }
   when(io.prepare.valid) {
@@ -470,9 +474,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     blockLeft := count - 2.U
     aLeft     := Mux(bipartite, split - 1.U, count - 2.U) // lastA
     headOffset := io.headPad
-    // lastA + d: headPad - 1 and - 2 come from the loader's register, not from the start.
-    val pad = io.headPad.pad(p.countWidth)
-    aTop       := Mux(bipartite, split + (pad - 1.U), count + (pad - 2.U))
     blockLeftIsM       := count === (m + 2).U
     aLeftAtLeast2m     := Mux(bipartite, jumps, count >= (2 * m + 2).U)
     blockEndNext     := count === 2.U // block 0 ends at once: left0 == 0
