@@ -52,18 +52,19 @@ ModelBackend::ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t ru
 }
 
 void ModelBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) {
-  runCell(boxes, 0, out, stats);
-  stats.loadCycles += boxes.size() + 1;  // one box a cycle, then the start cycle
-  stats.cycles += busyCycles(boxes.size());
-  stats.runs += 1;
-  stats.batches += 1;
+  runAlone(boxes, 0, out, stats);
 }
 
 void ModelBackend::runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
                                 RunStats& stats) {
   checkBipartite(boxes.size(), split);
+  runAlone(boxes, split, out, stats);
+}
+
+void ModelBackend::runAlone(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                            RunStats& stats) const {
   runCell(boxes, split, out, stats);
-  stats.loadCycles += boxes.size() + 1;
+  stats.loadCycles += boxes.size() + 1;  // one box a cycle, then the start cycle
   stats.cycles += busyCycles(boxes.size(), split);
   stats.runs += 1;
   stats.batches += 1;
@@ -103,7 +104,8 @@ void ModelBackend::runCell(std::span<const KeyBox> boxes, std::size_t split, std
     const std::size_t first = split > 2 * m_ ? std::max(base + 1, split - 2 * m_ + 1) : base + 1;
     for (std::size_t s = first; s < n; ++s) {
       bool hit = false;
-      const std::size_t lanes = std::min({m_, n - s, lastA + 1 - base + (split == 0)});
+      // Lanes past the last B object, and (bipartite) past the last A object, test nothing.
+      const std::size_t lanes = std::min({m_, n - s, (split == 0 ? n : split) - base});
       for (std::size_t k = s < split ? split - s : 0; k < lanes; ++k) {
         if (overlaps(boxes[base + k], boxes[s + k])) {
           out.emplace_back(static_cast<std::uint32_t>(base + k), static_cast<std::uint32_t>(s + k));

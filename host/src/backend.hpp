@@ -81,6 +81,8 @@ class ModelBackend final : public Backend {
   /// One cell's pairs and counters (split 0: all pairs), without counting it
   /// as a run; its load cycles and cycles depend on the hand-over (run, or batchCycles).
   void runCell(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats) const;
+  /// One cell as its own run and hand-over: runCell plus its loads and busy cycles.
+  void runAlone(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats) const;
   /// Cycles before a run of n objects issues (0 for the seed), and all its busy cycles.
   std::uint64_t startupCycles(std::uint64_t n) const;
   std::uint64_t busyCycles(std::uint64_t n, std::uint64_t split = 0) const;
