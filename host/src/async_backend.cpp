@@ -31,12 +31,9 @@ AsyncBackend::AsyncBackend(const DeviceFactory& makeDevice) {
 // queue first, so no submitted hand-over is dropped.
 AsyncBackend::~AsyncBackend() = default;
 
-std::future<BatchResult> AsyncBackend::submit(std::span<const std::span<const KeyBox>> cells) {
-  return enqueue(Job{{cells.begin(), cells.end()}, 0, {}});
-}
-
-std::future<BatchResult> AsyncBackend::submitBipartite(std::span<const KeyBox> boxes, std::size_t split) {
-  return enqueue(Job{{boxes}, split, {}});
+std::future<BatchResult> AsyncBackend::submit(std::span<const std::span<const KeyBox>> cells,
+                                              std::span<const std::size_t> splits) {
+  return enqueue(Job{{cells.begin(), cells.end()}, {splits.begin(), splits.end()}, {}});
 }
 
 std::future<BatchResult> AsyncBackend::enqueue(Job job) {
@@ -62,12 +59,7 @@ void AsyncBackend::serve(std::stop_token stop, Backend& device) {
     }
     BatchResult out;
     try {
-      if (job.split != 0) {
-        device.runBipartite(job.cells.front(), job.split, out.pairs, out.stats);
-        out.cellEnds.push_back(out.pairs.size());
-      } else {
-        device.runBatch(job.cells, out.pairs, out.cellEnds, out.stats);
-      }
+      device.runBatch(job.cells, job.splits, out.pairs, out.cellEnds, out.stats);
       job.result.set_value(std::move(out));
     } catch (...) {
       job.result.set_exception(std::current_exception());

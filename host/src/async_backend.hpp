@@ -49,15 +49,15 @@ class AsyncBackend {
   const std::string& name() const { return name_; }
   std::size_t capacity() const { return capacity_; }
   bool bipartite() const { return bipartite_; }
-  /// Queues one hand-over of `cells` (each at most capacity() boxes).
-  std::future<BatchResult> submit(std::span<const std::span<const KeyBox>> cells);
-  /// Queues one bipartite run (Backend::runBipartite), a hand-over of one cell.
-  std::future<BatchResult> submitBipartite(std::span<const KeyBox> boxes, std::size_t split);
+  /// Queues one hand-over of `cells` (each at most capacity() boxes), with
+  /// their bipartite splits as Backend::runBatch takes them (empty: none).
+  std::future<BatchResult> submit(std::span<const std::span<const KeyBox>> cells,
+                                  std::span<const std::size_t> splits = {});
 
  private:
   struct Job {
     std::vector<std::span<const KeyBox>> cells;
-    std::size_t split = 0;  // non-zero: one bipartite run of cells[0]
+    std::vector<std::size_t> splits;
     std::promise<BatchResult> result;
   };
   std::future<BatchResult> enqueue(Job job);

@@ -29,10 +29,30 @@ void Backend::checkBipartite(std::size_t n, std::size_t split) const {
     throw std::invalid_argument(fmt::format("{}: bipartite split {} outside 1 .. n-1 (n = {})", name(), split, n));
 }
 
-void Backend::runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
-                       std::vector<std::size_t>& cellEnds, RunStats& stats) {
-  for (const auto& cell : cells) {
-    run(cell, out, stats);
+void Backend::checkSplits(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits) const {
+  if (splits.empty()) return;
+  if (splits.size() != cells.size())
+    throw std::invalid_argument(
+        fmt::format("{}: {} splits for a batch of {} cells (give one per cell, or none)", name(), splits.size(),
+                    cells.size()));
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    if (splits[k] == 0) continue;
+    try {
+      checkBipartite(cells[k].size(), splits[k]);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(fmt::format("{} (cell {} of the batch)", e.what(), k));
+    }
+  }
+}
+
+void Backend::runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
+                       std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) {
+  checkSplits(cells, splits);
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    if (splits.empty() || splits[k] == 0)
+      run(cells[k], out, stats);
+    else
+      runBipartite(cells[k], splits[k], out, stats);
     cellEnds.push_back(out.size());
   }
 }
@@ -70,20 +90,23 @@ void ModelBackend::runAlone(std::span<const KeyBox> boxes, std::size_t split, st
   stats.batches += 1;
 }
 
-void ModelBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
-                            std::vector<std::size_t>& cellEnds, RunStats& stats) {
+void ModelBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
+                            std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) {
   for (const auto& cell : cells)
     if (cell.size() > capacity_)
       throw std::length_error(fmt::format("model: a cell of {} boxes exceeds the capacity {}", cell.size(), capacity_));
+  checkSplits(cells, splits);
   for (std::size_t first = 0; first < cells.size(); first += batchCells_) {
-    const auto batch = cells.subspan(first, std::min(batchCells_, cells.size() - first));
-    for (const auto& cell : batch) {
-      runCell(cell, 0, out, stats);
+    const std::size_t count = std::min(batchCells_, cells.size() - first);
+    const auto batch = cells.subspan(first, count);
+    const auto batchSplits = splits.empty() ? splits : splits.subspan(first, count);
+    for (std::size_t k = 0; k < count; ++k) {
+      runCell(batch[k], batchSplits.empty() ? 0 : batchSplits[k], out, stats);
       cellEnds.push_back(out.size());
     }
     // The cycles come from the batch's timeline, not from its cells one by one.
-    batchCycles(batch, stats);
-    stats.runs += batch.size();
+    batchCycles(batch, batchSplits, stats);
+    stats.runs += count;
     stats.batches += 1;
   }
 }
@@ -132,18 +155,19 @@ std::uint64_t ModelBackend::busyCycles(std::uint64_t n, std::uint64_t split) con
   return n < 2 ? 0 : startupCycles(n) + scheduleIssueCycles(n, m_, split) + overhead_;
 }
 
-void ModelBackend::batchCycles(std::span<const std::span<const KeyBox>> batch, RunStats& stats) const {
+void ModelBackend::batchCycles(std::span<const std::span<const KeyBox>> batch, std::span<const std::size_t> splits,
+                               RunStats& stats) const {
   // Cycle 0 takes the first count; every count and box is offered as soon as
   // the device can take it, and the consumer never stalls.
   std::uint64_t countTaken = 0;   // the cycle the device takes the cell's count
   std::uint64_t nextStart = 0;    // earliest start: the cycle after the last cell ended
   std::uint64_t end = 0, run = 0;
-  for (const auto& cell : batch) {
-    const std::uint64_t n = cell.size();
+  for (std::size_t k = 0; k < batch.size(); ++k) {
+    const std::uint64_t n = batch[k].size();
     const std::uint64_t lastBox = countTaken + n;  // one box a cycle after the count
     const std::uint64_t start = std::max(lastBox + 1, nextStart);
     const bool launched = n >= 2 && n <= capacity_;
-    const std::uint64_t busy = launched ? busyCycles(n) : 0;
+    const std::uint64_t busy = launched ? busyCycles(n, splits.empty() ? 0 : splits[k]) : 0;
     end = start + busy + 1;  // the front end's own cycle ends the cell
     run += busy + 1;
     nextStart = end + 1;

@@ -26,11 +26,19 @@ class Backend {
   virtual void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) = 0;
   /// Runs several cells, each at most capacity() boxes: appends each cell's
   /// pairs (indices local to that cell, i < j) to `out` in cell order and
-  /// pushes out.size() onto `cellEnds` after each cell. `stats.runs` counts
-  /// the cells; `stats.batches` the hand-overs to the device. By default each
-  /// cell is its own run (and so its own batch).
-  virtual void runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
-                        std::vector<std::size_t>& cellEnds, RunStats& stats);
+  /// pushes out.size() onto `cellEnds` after each cell. `splits` is empty
+  /// (every cell all-pairs) or holds one split per cell: 0 for all pairs, or
+  /// na in 1 .. n-1 for a bipartite run of that cell (see runBipartite; only
+  /// where bipartite()). `stats.runs` counts the cells; `stats.batches` the
+  /// hand-overs to the device. By default each cell is its own run (and so
+  /// its own batch).
+  virtual void runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
+                        std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats);
+  /// Every cell all-pairs.
+  void runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
+                std::vector<std::size_t>& cellEnds, RunStats& stats) {
+    runBatch(cells, {}, out, cellEnds, stats);
+  }
   /// Whether runBipartite() exists here (the stream architecture's device and its model).
   virtual bool bipartite() const { return false; }
   /// One bipartite run (one run, one batch): appends only the overlapping
@@ -42,6 +50,9 @@ class Backend {
  protected:
   /// For implementations of runBipartite: throws unless bipartite() and 1 <= split < n.
   void checkBipartite(std::size_t n, std::size_t split) const;
+  /// For implementations of runBatch: throws unless `splits` is empty or one
+  /// per cell, each 0 or a split checkBipartite allows.
+  void checkSplits(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits) const;
 };
 
 /// The accelerator's schedule in closed form: issue cycles of one run of n
@@ -70,8 +81,9 @@ class ModelBackend final : public Backend {
   std::string name() const override { return "model"; }
   std::size_t capacity() const override { return capacity_; }
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
-  void runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
-                std::vector<std::size_t>& cellEnds, RunStats& stats) override;
+  using Backend::runBatch;
+  void runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
+                std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) override;
   /// The stream architecture's (streamReadLatency > 0); the seed's hardware refuses a split.
   bool bipartite() const override { return streamReadLatency_ != 0; }
   void runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
@@ -86,8 +98,10 @@ class ModelBackend final : public Backend {
   /// Cycles before a run of n objects issues (0 for the seed), and all its busy cycles.
   std::uint64_t startupCycles(std::uint64_t n) const;
   std::uint64_t busyCycles(std::uint64_t n, std::uint64_t split = 0) const;
-  /// One hardware batch's load and run cycles, cell by cell on the device's timeline.
-  void batchCycles(std::span<const std::span<const KeyBox>> batch, RunStats& stats) const;
+  /// One hardware batch's load and run cycles, cell by cell on the device's
+  /// timeline (`splits`: one per cell, or empty).
+  void batchCycles(std::span<const std::span<const KeyBox>> batch, std::span<const std::size_t> splits,
+                   RunStats& stats) const;
 
   std::size_t m_;
   std::size_t capacity_;

@@ -53,6 +53,7 @@ struct BroadPhase::Worker {
     bool hasRegion = false;
     std::size_t splitAt = 0;
     int keep = 0;
+    std::size_t deviceSplit = 0;  // non-zero: the device runs it bipartite (Backend::runBatch's split)
   };
   struct Batch {
     std::vector<PendingCell> cells;
@@ -60,12 +61,11 @@ struct BroadPhase::Worker {
     std::vector<KeyBox> boxes;
     std::vector<std::span<const KeyBox>> cellSpans;  // what the backend gets, made at the hand-over
     std::vector<std::span<const std::uint32_t>> cellItems;
-    std::size_t bipartiteSplit = 0;  // non-zero: one bipartite run of its only cell (Backend::runBipartite)
+    std::vector<std::size_t> splits;  // the cells' device splits, made at the hand-over; empty: none has one
     void clear() {
       cells.clear();
       items.clear();
       boxes.clear();
-      bipartiteSplit = 0;
     }
   };
   Batch filling;   // the batch being filled
@@ -79,13 +79,13 @@ struct BroadPhase::Worker {
   // scene), else empty: they are gathered from `keys`. `lasting`: items and
   // packed stay valid until the batch is flushed, so a batch refers to them.
   // `below`: the cell's below() bits (with `lasting` only; empty: the region decides).
+  // `deviceSplit`: non-zero for a bipartite run of the cell (a chunk pair's cross pairs only).
   void submit(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-              std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep, bool lasting);
-  // A chunk pair as one bipartite hand-over: only pairs across `split`.
-  void submitBipartite(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, const Cell* region,
-                       std::size_t split);
+              std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep, bool lasting,
+              std::size_t deviceSplit = 0);
   void runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-              std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep);
+              std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep,
+              std::size_t deviceSplit);
   void flush();   // hands the batch being filled over, if any
   void finish();  // flush, then (asynchronous) wait for the batch in flight and decode it
   void collect(); // asynchronous: waits for the batch in flight and decodes it
@@ -322,7 +322,9 @@ void BroadPhase::finishCells(std::vector<Pair>& out) {
 // A cell within capacity is one run. A larger one is cut into k chunks of at
 // most capacity/2 boxes. Where the backend runs bipartite runs, each chunk
 // runs alone for its inside pairs and each two chunks p < q run as one
-// bipartite run for their cross pairs, so every pair is tested once.
+// bipartite run for their cross pairs, so every pair is tested once; all
+// of them fill batches like any cell, so a run loads while the one before
+// it computes.
 // Otherwise chunks p < q run together and keep their cross pairs, and each
 // chunk's inside pairs are kept from exactly one run: chunk p from run
 // (p, p+1), the last chunk from run (k-2, k-1); those runs test every
@@ -349,7 +351,7 @@ void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<con
       pairItems.assign(first.begin(), first.end());
       pairItems.insert(pairItems.end(), second.begin(), second.end());
       if (acrossOnly) {
-        submitBipartite(keys, pairItems, region, first.size());
+        submit(keys, pairItems, {}, {}, region, first.size(), kCross, false, first.size());
         continue;
       }
       int keep = kCross;
@@ -362,10 +364,11 @@ void BroadPhase::Worker::processCell(std::span<const KeyBox> keys, std::span<con
 
 void BroadPhase::Worker::submit(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
                                 std::span<const KeyBox> packed, std::span<const std::uint8_t> below,
-                                const Cell* region, std::size_t splitAt, int keep, bool lasting) {
+                                const Cell* region, std::size_t splitAt, int keep, bool lasting,
+                                std::size_t deviceSplit) {
   if (!lasting) below = {};  // valid during the call only: the region decides
   if (cellsPerBatch <= 1) {
-    runNow(keys, items, packed, below, region, splitAt, keep);
+    runNow(keys, items, packed, below, region, splitAt, keep, deviceSplit);
     return;
   }
   PendingCell cell;
@@ -373,6 +376,7 @@ void BroadPhase::Worker::submit(std::span<const KeyBox> keys, std::span<const st
   cell.hasRegion = region != nullptr;
   cell.splitAt = splitAt;
   cell.keep = keep;
+  cell.deviceSplit = deviceSplit;
   if (lasting && !packed.empty()) {
     cell.items = items;
     cell.boxes = packed;
@@ -391,28 +395,15 @@ void BroadPhase::Worker::submit(std::span<const KeyBox> keys, std::span<const st
   if (filling.cells.size() >= cellsPerBatch) flush();
 }
 
-void BroadPhase::Worker::submitBipartite(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
-                                         const Cell* region, std::size_t split) {
-  flush();  // a hand-over of its own, after the cells before it
-  PendingCell cell;
-  if (region) cell.region = *region;
-  cell.hasRegion = region != nullptr;
-  cell.splitAt = split;
-  cell.keep = kCross;
-  cell.copied = true;
-  cell.count = items.size();
-  filling.items.assign(items.begin(), items.end());
-  for (const std::uint32_t id : items) filling.boxes.push_back(keys[id]);
-  filling.cells.push_back(cell);
-  filling.bipartiteSplit = split;
-  flush();
-}
-
 void BroadPhase::Worker::flush() {
   if (filling.cells.empty()) return;
   filling.cellSpans.clear();
   filling.cellItems.clear();
+  filling.splits.clear();
+  bool anySplit = false;
+  for (const PendingCell& c : filling.cells) anySplit = anySplit || c.deviceSplit != 0;
   for (const PendingCell& c : filling.cells) {
+    if (anySplit) filling.splits.push_back(c.deviceSplit);
     filling.cellSpans.push_back(c.copied ? std::span<const KeyBox>(filling.boxes).subspan(c.begin, c.count) : c.boxes);
     filling.cellItems.push_back(c.copied ? std::span<const std::uint32_t>(filling.items).subspan(c.begin, c.count)
                                          : c.items);
@@ -421,14 +412,7 @@ void BroadPhase::Worker::flush() {
     local.clear();
     cellEnds.clear();
     handOver(
-        [&](RunStats& runStats) {
-          if (filling.bipartiteSplit == 0) {
-            backend->runBatch(filling.cellSpans, local, cellEnds, runStats);
-          } else {
-            backend->runBipartite(filling.cellSpans.front(), filling.bipartiteSplit, local, runStats);
-            cellEnds.push_back(local.size());
-          }
-        },
+        [&](RunStats& runStats) { backend->runBatch(filling.cellSpans, filling.splits, local, cellEnds, runStats); },
         [&] { decodeBatch(filling, local, cellEnds); });
     filling.clear();
     return;
@@ -439,9 +423,7 @@ void BroadPhase::Worker::flush() {
   // device holds stay valid) and `filling` takes the decoded one's storage.
   RunRecord record;
   record.readySeconds = seconds(frameStart, Clock::now()) - backendSeconds;
-  std::future<BatchResult> result = filling.bipartiteSplit == 0
-                                        ? async->submit(filling.cellSpans)
-                                        : async->submitBipartite(filling.cellSpans.front(), filling.bipartiteSplit);
+  std::future<BatchResult> result = async->submit(filling.cellSpans, filling.splits);
   try {
     collect();
   } catch (...) {
@@ -499,14 +481,20 @@ void BroadPhase::Worker::decodeBatch(const Batch& batch, std::span<const Pair> p
 
 void BroadPhase::Worker::runNow(std::span<const KeyBox> keys, std::span<const std::uint32_t> items,
                                 std::span<const KeyBox> packed, std::span<const std::uint8_t> below,
-                                const Cell* region, std::size_t splitAt, int keep) {
+                                const Cell* region, std::size_t splitAt, int keep, std::size_t deviceSplit) {
   if (packed.empty()) {
     gathered.resize(items.size());
     for (std::size_t t = 0; t < items.size(); ++t) gathered[t] = keys[items[t]];
     packed = gathered;
   }
   local.clear();
-  handOver([&](RunStats& runStats) { backend->run(packed, local, runStats); },
+  handOver(
+      [&](RunStats& runStats) {
+        if (deviceSplit == 0)
+          backend->run(packed, local, runStats);
+        else
+          backend->runBipartite(packed, deviceSplit, local, runStats);
+      },
            [&] { keptUntil(keepPairs(local, items, packed, below, region, splitAt, keep, roomFor(local.size()))); });
 }
 

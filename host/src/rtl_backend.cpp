@@ -196,19 +196,22 @@ void RtlBackend::runOnHardware(std::span<const KeyBox> boxes, std::size_t split,
   stats.beatsReceived += beats;
 }
 
-void RtlBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
-                          std::vector<std::size_t>& cellEnds, RunStats& stats) {
+void RtlBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
+                          std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) {
   for (std::size_t k = 0; k < cells.size(); ++k)
     if (cells[k].size() > capacity())
       throw std::length_error(
           fmt::format("rtl: cell {} has {} boxes, above the hardware capacity {}", k, cells[k].size(), capacity()));
+  checkSplits(cells, splits);
   const std::size_t pairsBefore = out.size();
   const std::size_t endsBefore = cellEnds.size();
   RunStats added;
   try {
-    for (std::size_t first = 0; first < cells.size(); first += BPACCEL_BATCH_CELLS)
-      batchOnHardware(cells.subspan(first, std::min<std::size_t>(BPACCEL_BATCH_CELLS, cells.size() - first)), out,
+    for (std::size_t first = 0; first < cells.size(); first += BPACCEL_BATCH_CELLS) {
+      const std::size_t count = std::min<std::size_t>(BPACCEL_BATCH_CELLS, cells.size() - first);
+      batchOnHardware(cells.subspan(first, count), splits.empty() ? splits : splits.subspan(first, count), out,
                       cellEnds, added);
+    }
   } catch (...) {
     reset();
     out.resize(pairsBefore);
@@ -218,14 +221,15 @@ void RtlBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std::v
   stats += added;
 }
 
-void RtlBackend::batchOnHardware(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
-                                 std::vector<std::size_t>& cellEnds, RunStats& stats) {
+void RtlBackend::batchOnHardware(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
+                                 std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) {
   VBroadPhaseAccel& top = *top_;
   const std::size_t batchPairsBefore = out.size();
   std::uint64_t issue = 0, boxes = 0;
-  for (const auto& cell : cells) {
-    issue += scheduleIssueCycles(cell.size(), BPACCEL_M);
-    boxes += cell.size();
+  const auto splitOf = [&](std::size_t k) -> std::size_t { return splits.empty() ? 0 : splits[k]; };
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    issue += scheduleIssueCycles(cells[k].size(), BPACCEL_M, splitOf(k));
+    boxes += cells[k].size();
   }
   // A bound far above any legal batch turns a hang into an error.
   const std::uint64_t limit = 64 * (issue + boxes + 1000 * (cells.size() + 1));
@@ -243,7 +247,7 @@ void RtlBackend::batchOnHardware(std::span<const std::span<const KeyBox>> cells,
     top.io_cells_valid = countOffered;
     if (countOffered) {
       top.io_cells_bits_count = static_cast<std::uint32_t>(cells[nextCount].size());
-      top.io_cells_bits_split = 0;  // the host batches triangular cells; bipartite runs go alone
+      top.io_cells_bits_split = static_cast<std::uint32_t>(splitOf(nextCount));
     }
     const bool boxOffered = cell < cells.size();
     top.io_load_valid = boxOffered;

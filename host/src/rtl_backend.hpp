@@ -30,12 +30,13 @@ class RtlBackend final : public Backend {
   /// On any failure (a hang, a hardware error) the device is reset before the
   /// exception leaves, so the next run starts from an idle accelerator.
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
-  /// Pushes the cells' counts on the batch port and streams their boxes, one
-  /// a cycle, as hardware batches of at most batchCells() cells each. On any
-  /// failure the device is reset and nothing of the call is left in `out`,
-  /// `cellEnds` or `stats`.
-  void runBatch(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
-                std::vector<std::size_t>& cellEnds, RunStats& stats) override;
+  /// Pushes the cells' counts (and splits) on the batch port and streams
+  /// their boxes, one a cycle, as hardware batches of at most batchCells()
+  /// cells each. On any failure the device is reset and nothing of the call
+  /// is left in `out`, `cellEnds` or `stats`.
+  using Backend::runBatch;
+  void runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
+                std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) override;
   /// BPACCEL_BIPARTITE_RUNS: the stream architecture's hardware.
   bool bipartite() const override;
   /// One start with the split; the same reset on failure as run().
@@ -54,8 +55,8 @@ class RtlBackend final : public Backend {
   void reset();
   void runGuarded(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats);
   void runOnHardware(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats);
-  void batchOnHardware(std::span<const std::span<const KeyBox>> cells, std::vector<Pair>& out,
-                       std::vector<std::size_t>& cellEnds, RunStats& stats);
+  void batchOnHardware(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
+                       std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats);
 
   std::unique_ptr<VerilatedContext> context_;
   std::unique_ptr<VBroadPhaseAccel> top_;

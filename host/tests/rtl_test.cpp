@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <gtest/gtest-spi.h>
 #include <gtest/gtest.h>
 
@@ -336,6 +337,83 @@ TEST(RtlBatch, AgreesWithTheModelAndWithTheCellsRunOneByOne) {
                               BPACCEL_BATCH_CELLS, BPACCEL_BATCH_OVERLAPS_LOADS == 0);
     EXPECT_NE(runBatchOn(wrongOverlap, b).stats.loadCycles, r.loadCycles) << label;
   }
+}
+
+TEST(RtlBatch, BipartiteCellsInABatchAgreeWithTheModelAndWithTheirSingleRuns) {
+  RtlBackend rtl;
+  ModelBackend model = modelOfBuiltHardware();
+  const Batch b = randomBatch(BPACCEL_BATCH_CELLS + 5, 9, true);
+  // About half the cells of two or more objects bipartite, at a random split.
+  std::mt19937 rng(10);
+  std::vector<std::size_t> splits;
+  for (const auto& cell : b.spans)
+    splits.push_back(cell.size() >= 2 && rng() % 2 ? 1 + rng() % (cell.size() - 1) : 0);
+  ASSERT_GT(std::count_if(splits.begin(), splits.end(), [](std::size_t s) { return s != 0; }), 10);
+  BatchResult fromRtl;
+  if (!rtl.bipartite()) {
+    // The seed's device refuses a split: nothing reaches it.
+    EXPECT_THROW(rtl.runBatch(b.spans, splits, fromRtl.pairs, fromRtl.cellEnds, fromRtl.stats), std::logic_error);
+    EXPECT_THROW(model.runBatch(b.spans, splits, fromRtl.pairs, fromRtl.cellEnds, fromRtl.stats), std::logic_error);
+    EXPECT_EQ(fromRtl.stats.runs, 0u);
+    return;
+  }
+  rtl.runBatch(b.spans, splits, fromRtl.pairs, fromRtl.cellEnds, fromRtl.stats);
+  BatchResult fromModel;
+  model.runBatch(b.spans, splits, fromModel.pairs, fromModel.cellEnds, fromModel.stats);
+  EXPECT_EQ(fromRtl.pairs, fromModel.pairs);
+  EXPECT_EQ(fromRtl.cellEnds, fromModel.cellEnds);
+  const RunStats& r = fromRtl.stats;
+  const RunStats& m = fromModel.stats;
+  EXPECT_EQ(r.runs, b.spans.size());
+  EXPECT_EQ(r.batches, hardwareBatches(b.spans.size()));
+  EXPECT_EQ(r.loadCycles, m.loadCycles);
+  EXPECT_EQ(r.cycles, m.cycles);
+  EXPECT_EQ(r.issueCycles, m.issueCycles);
+  EXPECT_EQ(r.beatsReceived, m.beatsReceived);
+  // Cell by cell: what the cell's single run gives (bipartite or not), the
+  // same cycles plus the front end's one per cell, and loads the runs hide.
+  RunStats singles;
+  for (std::size_t k = 0; k < b.spans.size(); ++k) {
+    std::vector<Pair> one;
+    if (splits[k] == 0)
+      rtl.run(b.spans[k], one, singles);
+    else
+      rtl.runBipartite(b.spans[k], splits[k], one, singles);
+    EXPECT_EQ(cellPairs(fromRtl, k), one) << "cell " << k;
+    std::vector<Pair> expected;
+    for (const Pair& p : bruteForce(b.boxes[k]))
+      if (splits[k] == 0 || (p.first < splits[k] && p.second >= splits[k])) expected.push_back(p);
+    EXPECT_EQ(sorted(one), expected) << "cell " << k << " split " << splits[k];
+  }
+  EXPECT_EQ(r.issueCycles, singles.issueCycles);
+  EXPECT_EQ(r.cycles, singles.cycles + b.spans.size());
+  EXPECT_LT(r.loadCycles, singles.loadCycles + r.batches);
+}
+
+TEST(RtlBatch, RefusesBadSplitsNamingTheCellBeforeTouchingTheDevice) {
+  RtlBackend rtl;
+  ModelBackend model = modelOfBuiltHardware();
+  const Batch b = randomBatch(4, 11, false);
+  const std::vector<std::size_t> tooFew = {0, 0};
+  std::vector<std::size_t> atN(b.spans.size(), 0);
+  atN.back() = b.spans.back().size();  // a split must lie below n
+  for (Backend* backend : {static_cast<Backend*>(&rtl), static_cast<Backend*>(&model)}) {
+    BatchResult r;
+    EXPECT_THROW(backend->runBatch(b.spans, tooFew, r.pairs, r.cellEnds, r.stats), std::invalid_argument);
+    if (backend->bipartite()) {
+      try {
+        backend->runBatch(b.spans, atN, r.pairs, r.cellEnds, r.stats);
+        ADD_FAILURE() << backend->name() << " took a split of n";
+      } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("cell 3"), std::string::npos) << e.what();
+      }
+    }
+    EXPECT_TRUE(r.pairs.empty());
+    EXPECT_TRUE(r.cellEnds.empty());
+    EXPECT_EQ(r.stats.runs, 0u);
+  }
+  // And the device is still fine.
+  EXPECT_EQ(runBatchOn(rtl, b).pairs, runBatchOn(model, b).pairs);
 }
 
 TEST(RtlBatch, StallingConsumerLosesNoPairAndCountsTheStalls) {
