@@ -67,16 +67,15 @@ class BatchControl(p: AccelParams) extends Module {
   tailIn.valid   := io.cells.valid && takesCount
   tailIn.bits    := CellCount(p, io.cells.bits)
   io.cells.ready := tailIn.ready && takesCount
-  // Its head is a register (see RegisteredHeadQueue): the library queue's
-  // LUT RAM read was seed m = 8's critical path into `left` (116.9 MHz with
-  // ecp5-outreg memories). Its valid is that register or the count flowing
-  // through: the queue's own pointers, compared, were once stream m = 32's
-  // critical path (597e8e6, 100.2 MHz: tail pointers -> take -> the
-  // loader's and the engine's clear).
-  val tailQueue = Module(new RegisteredHeadQueue(new CellCount(p), p.batchCells - 1)) // no entries: a wire
-  tailQueue.io.enq <> tailIn
-  val tail      = tailQueue.io.deq
-  val tailValid = tail.valid
+  val tail = Queue(tailIn, p.batchCells - 1, flow = true) // no entries: a wire
+  // Whether the tail offers a count, from a register (the queue held one at
+  // the cycle's start) or the count flowing through: the queue's own valid
+  // compares its pointers, and with overlapped loads every count taken
+  // clears the loader (stream m = 32's critical path at 597e8e6, 100.2 MHz:
+  // tail pointers -> take -> the loader's and the engine's clear).
+  val tailHolds = RegInit(false.B)
+  val tailValid = tailHolds || tailIn.valid
+  assert(tailValid === tail.valid, "the tail queue's registered non-empty flag is wrong")
   val tailFire = tailValid && tail.ready
   // Outside a batch the tail is empty and a count flows straight to the head,
   // so the first count is taken without asking the tail queue: its pointers
@@ -107,6 +106,14 @@ class BatchControl(p: AccelParams) extends Module {
   tail.ready := !active || headFree
   io.take.valid := tailFire
   io.take.bits  := tail.bits
+  // Counts held in the tail queue, kept beside it: an arriving count is
+  // stored unless it flows straight to the head (queue empty, taken at once).
+  val tailCount = RegInit(0.U(log2Ceil(p.batchCells).W))
+  val stored    = tailIn.fire && !(tailFire && !tailHolds)
+  val unstored  = tailFire && tailHolds
+  val tailCountNext = tailCount + stored.asUInt - unstored.asUInt
+  tailCount := tailCountNext
+  tailHolds := tailCountNext =/= 0.U
   when(io.start.valid) {
     running := true.B
     loading := false.B
