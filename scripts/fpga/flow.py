@@ -418,9 +418,6 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--timeout", type=float, default=None, help="seconds for the whole run (exit 4 past it)")
     ap.add_argument("--no-xilinx", action="store_true", help="skip the Xilinx estimate")
     ap.add_argument("--no-breakdown", action="store_true", help="skip the per-module ECP5 synthesis")
-    ap.add_argument("--no-lutram", action="store_true",
-                    help="ECP5: small memories (the queues) in flip-flops, not LUT RAM (synth_ecp5 -nolutram); "
-                         "a LUT RAM's write-clock-to-output arc was seed m = 8's critical path")
     ap.add_argument("--debian-yosys", default=DEBIAN_YOSYS, help="Yosys for synth_xilinx")
     ap.add_argument("--update-breakdown", action="store_true",
                     help="only redo the per-part breakdown of an existing --out report (keeps its other numbers)")
@@ -487,7 +484,7 @@ def flow(args) -> int:
     (work / "ecp5.ys").write_text(
         f"read_verilog -sv {ecp5_src_list} fpga_wrapper.v\n"
         f"{KEEP_REPLICAS}"
-        f"synth_ecp5 -top {WRAPPER_TOP} -json ecp5.json{' -nolutram' if args.no_lutram else ''}\n"
+        f"synth_ecp5 -top {WRAPPER_TOP} -json ecp5.json\n"
         f"tee -q -o ecp5_stat.json stat -json\n")
     code, ytext = runner.run("yosys synth_ecp5", [yosys, "-q", "-l", "ecp5.log", "-s", "ecp5.ys"], "ecp5.stdout")
     ytext = (work / "ecp5.log").read_text(errors="replace") if (work / "ecp5.log").exists() else ytext
@@ -773,7 +770,6 @@ def base_report(m, capacity, params, args, versions, wrapper_info) -> dict:
                  "xilinx": f"7-series family (synth_xilinx -family {XILINX_FAMILY}), no specific device"},
         "clock_constraint_mhz": args.clock_mhz,
         "nextpnr_seed": args.seed,
-        "synth_ecp5_options": ["-nolutram"] if args.no_lutram else [],
         "nextpnr_router": getattr(args, "router", "router1"),
         "nextpnr_threads": getattr(args, "threads", 1),
         "nextpnr_placer": getattr(args, "placer", None) or "default",
