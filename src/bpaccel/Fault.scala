@@ -31,6 +31,8 @@ object Fault {
   case object HeadCopyOffByOne extends Fault("the stream's start copies the head registers into the window one lane off")
   /** The stream's window enables, computed a cycle ahead, ignore the result queue's back-pressure. */
   case object LookaheadIgnoresRoom extends Fault("the stream's look-ahead window enables ignore back-pressure")
+  /** A bipartite stream run does not mask the A lanes past the last A object: they test pairs inside B. */
+  case object BipartiteALanesUnmasked extends Fault("a bipartite run's lanes past the last A object are not masked")
   /** The batch front end does not count cells of fewer than two objects: later cells get the wrong tag. */
   case object CellCounterSkipsShortCells extends Fault("the batch's cell counter skips cells of 0 or 1 objects")
   /** The batch front end takes the next count only when a cell ends, as before loads overlapped runs. */
@@ -47,6 +49,7 @@ object Fault {
     DoneClearedByLoad,
     ErrorStartLaunches,
     LaneMaskOneTooWide,
+    BipartiteALanesUnmasked,
     RepeatLastBeat,
     SkipSecondBlockAtMPlus2,
     StrictCompare,

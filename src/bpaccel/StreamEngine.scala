@@ -524,7 +524,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     // past the last A object.
     headOffset <= k.U &&
       (if (p.has(Fault.LaneMaskOneTooWide)) laneTop +& 1.U >= k.U else laneTop >= k.U) &&
-      aTop >= k.U && window(k).inB)).asUInt
+      (aTop >= k.U || p.has(Fault.BipartiteALanesUnmasked).B) && window(k).inB)).asUInt
   if (p.debugPort) {
     // The objects each lane really holds, from the tags that travelled with
     // the data, moved down by d lanes as the hit mask is.

@@ -16,9 +16,9 @@ object Property {
   case object Done extends Property("done")
   /** A start with an error (or fewer than two objects) ends at once with its code and no beat. */
   case object ErrorStart extends Property("error-start")
-  /** Each lane compares i < j < n, and the beats of a run are distinct pairs. */
+  /** Each lane compares i < j < n (a bipartite run: i < na <= j), and the beats of a run are distinct pairs. */
   case object Lanes extends Property("lanes")
-  /** A run tests n(n-1)/2 pairs (with [[Lanes]]: all of them), and each hit bit is the overlap of boxes i and j. */
+  /** A run tests n(n-1)/2 pairs, a bipartite one na(n-na) (with [[Lanes]]: all of them), and each hit bit is the overlap of boxes i and j. */
   case object Pairs extends Property("pairs")
 
   val all: Seq[Property] = Seq(ExactlyOnce, Done, ErrorStart, Lanes, Pairs)
@@ -44,10 +44,7 @@ class FormalHarness(p: AccelParams, properties: Set[Property] = Property.all.toS
 
   val dut = Module(new BroadPhaseAccel(p))
   dut.io.load <> io.load
-  dut.io.start <> io.start
-  // Triangular runs only: bipartite runs are checked in simulation
-  // (ScheduleHardwareSpec, BatchSpec, ProtocolSpec), against their golden model.
-  assume(io.start.bits.split === 0.U, "the formal checks cover triangular runs: split 0")
+  dut.io.start <> io.start // any split: triangular runs (0), bipartite ones, and bad splits
   // Single runs only: batches are checked in simulation (BatchSpec). An
   // assumption rather than a constant, which firrtl2's constant propagation
   // cannot fold through the batch front end (it fails with an internal error).
@@ -70,6 +67,7 @@ class FormalHarness(p: AccelParams, properties: Set[Property] = Property.all.toS
     when(loaded <= p.capacity.U) { loaded := loaded + 1.U }
   }
   val n         = Reg(UInt(p.countWidth.W))
+  val na        = Reg(UInt(p.countWidth.W)) // the run's split: 0, or the A objects of a bipartite run
   val goodRun   = RegInit(false.B) // the last start launched a run of n >= 2 objects
   val quietRun  = RegInit(false.B) // the last start had an error or n < 2: nothing may be compared
   val startCode = Wire(AccelError())
@@ -78,7 +76,9 @@ class FormalHarness(p: AccelParams, properties: Set[Property] = Property.all.toS
     Seq(
       (loaded > p.capacity.U)      -> AccelError.LoadOverflow,
       (io.start.bits.count > p.capacity.U) -> AccelError.CountOverCapacity,
-      (io.start.bits.count > loaded)     -> AccelError.CountOverLoaded
+      (io.start.bits.count > loaded)     -> AccelError.CountOverLoaded,
+      (io.start.bits.split =/= 0.U && !p.bipartiteRuns.B) -> AccelError.SplitUnsupported,
+      (io.start.bits.split =/= 0.U && io.start.bits.split >= io.start.bits.count) -> AccelError.SplitOutOfRange
     )
   )
   val startedQuiet = RegNext(io.start.fire && (startCode =/= AccelError.None || io.start.bits.count < 2.U), false.B)
@@ -86,15 +86,24 @@ class FormalHarness(p: AccelParams, properties: Set[Property] = Property.all.toS
   when(io.start.fire) {
     loaded   := 0.U
     n        := io.start.bits.count
+    na       := io.start.bits.split
     goodRun  := startCode === AccelError.None && io.start.bits.count >= 2.U
     quietRun := !(startCode === AccelError.None && io.start.bits.count >= 2.U)
   }
 
+  // ---- the cycle's beat: (iBase, jBase) with lane k on (iBase + k, jBase + k) ----
+  // Read off the lowest lane that compares: in a bipartite run lane 0 may
+  // not, and after the reader's jump it holds an object of A that does not
+  // follow the window's later lanes (the beat names the objects compared).
+  val anyValid = lanes.map(_.valid).reduce(_ || _)
+  val iBase    = PriorityMux(lanes.map(_.valid), lanes.zipWithIndex.map { case (l, k) => l.i - k.U })
+  val jBase    = PriorityMux(lanes.map(_.valid), lanes.zipWithIndex.map { case (l, k) => l.j - k.U })
+
   // ---- a model of the result queue: the beats that entered it and were not yet taken ----
   val hitMask  = VecInit(lanes.map(_.hit)).asUInt
   val entering = Wire(new ResultBeat(p))
-  entering.iBase := lanes(0).i
-  entering.jBase := lanes(0).j
+  entering.iBase := iBase
+  entering.jBase := jBase
   entering.mask  := hitMask
   entering.cell  := 0.U
   val enters  = cycle && hitMask.orR
@@ -127,36 +136,40 @@ class FormalHarness(p: AccelParams, properties: Set[Property] = Property.all.toS
   check(Property.ErrorStart, !startedQuiet || (status.done && !status.busy && status.error === quietCode),
     "a start with an error or fewer than two objects did not end at once with its code")
 
-  // ---- lanes: i < j < n, and the run's pairs are distinct ----
+  // ---- lanes: i < j < n (bipartite: i < na <= j), and the run's pairs are distinct ----
   for (k <- 0 until m) {
     val lane = lanes(k)
     check(Property.Lanes, !lane.valid || cycle, "a lane is valid outside a schedule cycle")
     check(Property.Lanes, !(cycle && lane.hit) || lane.valid, "a lane hits without a comparison")
     check(Property.Lanes, !lane.valid || (lane.i < lane.j && lane.j < n), "a lane compares i >= j or j >= n")
-    check(Property.Lanes, !lane.valid || (lane.i === lanes(0).i + k.U && lane.j === lanes(0).j + k.U),
+    check(Property.Lanes, !lane.valid || na === 0.U || (lane.i < na && na <= lane.j),
+      "a lane of a bipartite run compares a pair not across its split")
+    check(Property.Lanes, !lane.valid || (lane.i === iBase + k.U && lane.j === jBase + k.U),
       "lane k does not hold objects iBase + k and jBase + k")
   }
-  check(Property.Lanes, !cycle || (lanes(0).valid && goodRun), "a schedule cycle without lane 0 or outside a run")
+  check(Property.Lanes, !cycle || goodRun, "a schedule cycle outside a run")
+  check(Property.Lanes, !cycle || na =/= 0.U || lanes(0).valid, "a schedule cycle of a triangular run without lane 0")
   // Beats (iBase, jBase) rise strictly, iBase a multiple of m: then pair (iBase + k, jBase + k)
   // names its beat and lane, so no pair is tested twice.
-  check(Property.Lanes, !cycle || lanes(0).i % m.U === 0.U, "iBase is not a multiple of m")
+  val compares = cycle && anyValid
+  check(Property.Lanes, !compares || iBase % m.U === 0.U, "iBase is not a multiple of m")
   val seen  = RegInit(false.B)
   val lastI = Reg(UInt(p.indexWidth.W))
   val lastJ = Reg(UInt(p.indexWidth.W))
   check(Property.Lanes,
-    !(cycle && seen) || lanes(0).i > lastI || (lanes(0).i === lastI && lanes(0).j > lastJ),
+    !(compares && seen) || iBase > lastI || (iBase === lastI && jBase > lastJ),
     "a beat's (iBase, jBase) does not follow the previous one's: a pair may repeat")
-  when(cycle) { seen := true.B; lastI := lanes(0).i; lastJ := lanes(0).j }
+  when(compares) { seen := true.B; lastI := iBase; lastJ := jBase }
   when(io.start.fire) { seen := false.B }
 
-  // ---- pairs: all n(n-1)/2 tested, each hit bit right ----
+  // ---- pairs: all n(n-1)/2 tested (bipartite: na(n-na)), each hit bit right ----
   val pairWidth = log2Ceil(p.capacity * (p.capacity - 1) / 2 + 1) + 1
   val tested    = RegInit(0.U(pairWidth.W))
   when(cycle) { tested := tested + PopCount(lanes.map(_.valid)) }
   when(io.start.fire) { tested := 0.U }
-  val allPairs = (n * (n - 1.U)) >> 1
+  val allPairs = Mux(na === 0.U, (n * (n - 1.U)) >> 1, na * (n - na))
   check(Property.Pairs, !(status.done && goodRun) || tested === allPairs,
-    "a run ended without testing n(n-1)/2 pairs")
+    "a run ended without testing n(n-1)/2 pairs, or na(n-na) across a split")
   private def overlap(x: Aabb, y: Aabb): Bool =
     (0 until 3).map(a => x.min(a) <= y.max(a) && y.min(a) <= x.max(a)).reduce(_ && _)
   for (lane <- lanes) {
