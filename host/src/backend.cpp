@@ -49,7 +49,7 @@ void Backend::runBatch(std::span<const std::span<const KeyBox>> cells, std::span
                        std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) {
   checkSplits(cells, splits);
   for (std::size_t k = 0; k < cells.size(); ++k) {
-    if (splits.empty() || splits[k] == 0)
+    if (splitOf(splits, k) == 0)
       run(cells[k], out, stats);
     else
       runBipartite(cells[k], splits[k], out, stats);
@@ -99,9 +99,9 @@ void ModelBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std:
   for (std::size_t first = 0; first < cells.size(); first += batchCells_) {
     const std::size_t count = std::min(batchCells_, cells.size() - first);
     const auto batch = cells.subspan(first, count);
-    const auto batchSplits = splits.empty() ? splits : splits.subspan(first, count);
+    const auto batchSplits = splitsOf(splits, first, count);
     for (std::size_t k = 0; k < count; ++k) {
-      runCell(batch[k], batchSplits.empty() ? 0 : batchSplits[k], out, stats);
+      runCell(batch[k], splitOf(batchSplits, k), out, stats);
       cellEnds.push_back(out.size());
     }
     // The cycles come from the batch's timeline, not from its cells one by one.
@@ -167,7 +167,7 @@ void ModelBackend::batchCycles(std::span<const std::span<const KeyBox>> batch, s
     const std::uint64_t lastBox = countTaken + n;  // one box a cycle after the count
     const std::uint64_t start = std::max(lastBox + 1, nextStart);
     const bool launched = n >= 2 && n <= capacity_;
-    const std::uint64_t busy = launched ? busyCycles(n, splits.empty() ? 0 : splits[k]) : 0;
+    const std::uint64_t busy = launched ? busyCycles(n, splitOf(splits, k)) : 0;
     end = start + busy + 1;  // the front end's own cycle ends the cell
     run += busy + 1;
     nextStart = end + 1;

@@ -53,6 +53,15 @@ class Backend {
   /// For implementations of runBatch: throws unless `splits` is empty or one
   /// per cell, each 0 or a split checkBipartite allows.
   void checkSplits(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits) const;
+  /// Cell k's split in runBatch's `splits` (empty: every cell all-pairs, 0).
+  static std::size_t splitOf(std::span<const std::size_t> splits, std::size_t k) {
+    return splits.empty() ? 0 : splits[k];
+  }
+  /// The splits of cells [first, first + count) (empty stays empty).
+  static std::span<const std::size_t> splitsOf(std::span<const std::size_t> splits, std::size_t first,
+                                               std::size_t count) {
+    return splits.empty() ? splits : splits.subspan(first, count);
+  }
 };
 
 /// The accelerator's schedule in closed form: issue cycles of one run of n

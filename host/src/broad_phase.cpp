@@ -495,7 +495,7 @@ void BroadPhase::Worker::runNow(std::span<const KeyBox> keys, std::span<const st
         else
           backend->runBipartite(packed, deviceSplit, local, runStats);
       },
-           [&] { keptUntil(keepPairs(local, items, packed, below, region, splitAt, keep, roomFor(local.size()))); });
+      [&] { keptUntil(keepPairs(local, items, packed, below, region, splitAt, keep, roomFor(local.size()))); });
 }
 
 template <typename Run, typename Decode>

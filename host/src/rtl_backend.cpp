@@ -209,8 +209,7 @@ void RtlBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std::s
   try {
     for (std::size_t first = 0; first < cells.size(); first += BPACCEL_BATCH_CELLS) {
       const std::size_t count = std::min<std::size_t>(BPACCEL_BATCH_CELLS, cells.size() - first);
-      batchOnHardware(cells.subspan(first, count), splits.empty() ? splits : splits.subspan(first, count), out,
-                      cellEnds, added);
+      batchOnHardware(cells.subspan(first, count), splitsOf(splits, first, count), out, cellEnds, added);
     }
   } catch (...) {
     reset();
@@ -226,9 +225,8 @@ void RtlBackend::batchOnHardware(std::span<const std::span<const KeyBox>> cells,
   VBroadPhaseAccel& top = *top_;
   const std::size_t batchPairsBefore = out.size();
   std::uint64_t issue = 0, boxes = 0;
-  const auto splitOf = [&](std::size_t k) -> std::size_t { return splits.empty() ? 0 : splits[k]; };
   for (std::size_t k = 0; k < cells.size(); ++k) {
-    issue += scheduleIssueCycles(cells[k].size(), BPACCEL_M, splitOf(k));
+    issue += scheduleIssueCycles(cells[k].size(), BPACCEL_M, splitOf(splits, k));
     boxes += cells[k].size();
   }
   // A bound far above any legal batch turns a hang into an error.
@@ -247,7 +245,7 @@ void RtlBackend::batchOnHardware(std::span<const std::span<const KeyBox>> cells,
     top.io_cells_valid = countOffered;
     if (countOffered) {
       top.io_cells_bits_count = static_cast<std::uint32_t>(cells[nextCount].size());
-      top.io_cells_bits_split = static_cast<std::uint32_t>(splitOf(nextCount));
+      top.io_cells_bits_split = static_cast<std::uint32_t>(splitOf(splits, nextCount));
     }
     const bool boxOffered = cell < cells.size();
     top.io_load_valid = boxOffered;
