@@ -499,6 +499,11 @@ bool UniformGrid::place(std::span<const KeyBox> boxes, std::size_t cellSize, con
   // A box in its first cell lies below it on no axis: those bits are cleared
   // in one sweep, not written one by one beside the items.
   std::fill(below, below + total, std::uint8_t{0});
+  // Touched in order first: the scatter's stores land at random, and on lines
+  // a frame's other work evicted each one missed alone (frame_timing --evict,
+  // 8000 boxes, grid 64: the build's median 107 -> 96 us); the stream of
+  // writes here is one the hardware prefetches.
+  std::fill(items, items + total, std::uint32_t{0});
   for (std::size_t i = 0; i < boxes.size(); ++i) items[cursor[firsts[i]]++] = static_cast<std::uint32_t>(i);
   for (const Extra& e : std::span<const Extra>(extras_).first(extraCount_)) {
     const std::uint64_t at = cursor[e.cell]++;
