@@ -539,6 +539,72 @@ TEST(BroadPhase, BatchesOfCellsGiveExactlyThePairsOfSingleRunsWithTheSameCycles)
   }
 }
 
+namespace {
+
+// Wraps a backend and records each batch's cell sizes as they reach it.
+class BatchRecordingBackend final : public Backend {
+ public:
+  explicit BatchRecordingBackend(Backend& inner) : inner_(inner) {}
+  std::string name() const override { return inner_.name(); }
+  std::size_t capacity() const override { return inner_.capacity(); }
+  bool bipartite() const override { return inner_.bipartite(); }
+  void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override {
+    batches.push_back({boxes.size()});
+    inner_.run(boxes, out, stats);
+  }
+  using Backend::runBatch;
+  void runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
+                std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) override {
+    std::vector<std::size_t>& sizes = batches.emplace_back();
+    for (const auto& cell : cells) sizes.push_back(cell.size());
+    auto& copies = cellBoxes.emplace_back();
+    for (const auto& cell : cells) copies.emplace_back(cell.begin(), cell.end());
+    inner_.runBatch(cells, splits, out, cellEnds, stats);
+  }
+  std::vector<std::vector<std::size_t>> batches;
+  std::vector<std::vector<std::vector<KeyBox>>> cellBoxes;
+
+ private:
+  Backend& inner_;
+};
+
+}  // namespace
+
+TEST(BroadPhase, BatchesReachTheDeviceInAscendingCellSizeSoThatTheirLoadsHide) {
+  // The stream's model: each cell loads while the one before runs.
+  ModelBackend stream(8, 256, 3, 4, 64, true);
+  const std::vector<Aabb> boxes = scatteredBoxes(3000, 21, -40, 40, 0, 3);
+  for (const PartitionKind partition : {PartitionKind::UniformGrid, PartitionKind::KdTree})
+    for (const std::size_t perBatch : {7u, 64u}) {
+      const std::string label = std::string(partitionName(partition)) + " per batch " + std::to_string(perBatch);
+      BatchRecordingBackend recording(stream);
+      BroadPhase bp(recording, 32, perBatch, partition);
+      std::vector<Pair> pairs;
+      bp.findPairs(boxes, pairs);
+      EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << label;
+      ASSERT_GT(recording.batches.size(), 2u) << label;
+      bool someBatchWasOutOfOrder = false;
+      RunStats ascending, descending;
+      for (std::size_t b = 0; b < recording.batches.size(); ++b) {
+        const auto& sizes = recording.batches[b];
+        EXPECT_TRUE(std::is_sorted(sizes.begin(), sizes.end())) << label << " batch " << b;
+        // The same cells largest first: each cell's loads now outlast the run before.
+        std::vector<std::span<const KeyBox>> inOrder(recording.cellBoxes[b].begin(), recording.cellBoxes[b].end());
+        std::vector<std::span<const KeyBox>> reversed(inOrder.rbegin(), inOrder.rend());
+        std::vector<Pair> scratch;
+        std::vector<std::size_t> ends;
+        stream.runBatch(inOrder, scratch, ends, ascending);
+        stream.runBatch(reversed, scratch, ends, descending);
+        someBatchWasOutOfOrder = someBatchWasOutOfOrder || sizes.front() != sizes.back();
+      }
+      ASSERT_TRUE(someBatchWasOutOfOrder) << label << ": the scene must give cells of different sizes";
+      EXPECT_EQ(ascending.loadCycles, bp.stats().loadCycles) << label;
+      EXPECT_EQ(ascending.cycles, bp.stats().cycles) << label;
+      EXPECT_LT(ascending.loadCycles, descending.loadCycles) << label;
+      EXPECT_EQ(ascending.issueCycles, descending.issueCycles) << label;
+    }
+}
+
 TEST(BroadPhase, BatchesWorkOnSeveralThreadsAndRejectZeroCellsPerBatch) {
   BroadPhase model([] { return std::make_unique<ModelBackend>(2, 6, 5); }, 16, 2, 5);
   for (std::size_t n : {0u, 2u, 300u, 1000u})
