@@ -407,9 +407,10 @@ void BroadPhase::Worker::flush() {
   // the current one runs (the stream's) hides those loads only under a run
   // about as long; in the partition's order a small cell before a large one
   // left the difference in the open (bench, 8000 boxes, grid 64: loads were
-  // about 1,030 of 14,700 device cycles; in ascending size 320 of 14,000). Cells decode by
-  // their own records, so any order gives the same pairs. A counting sort:
-  // std::sort's mispredicted compares cost about a microsecond a batch of 64.
+  // about 1,030 of 14,700 device cycles; in ascending size 320 of 14,000).
+  // Cells decode by their own records, so any order gives the same pairs. A
+  // counting sort: std::sort's mispredicted compares cost about a microsecond
+  // a batch of 64.
   // Cells of kSizeBuckets - 1 boxes or more share the last bucket in the
   // partition's order, as before (the bench's cells rarely get there).
   const auto bucketOf = [](const PendingCell& c) { return std::min(c.size(), kSizeBuckets - 1); };
