@@ -49,10 +49,11 @@ void Backend::runBatch(std::span<const std::span<const KeyBox>> cells, std::span
                        std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) {
   checkSplits(cells, splits);
   for (std::size_t k = 0; k < cells.size(); ++k) {
-    if (splitOf(splits, k) == 0)
+    const std::size_t split = splitOf(splits, k);
+    if (split == 0)
       run(cells[k], out, stats);
     else
-      runBipartite(cells[k], splits[k], out, stats);
+      runBipartite(cells[k], split, out, stats);
     cellEnds.push_back(out.size());
   }
 }

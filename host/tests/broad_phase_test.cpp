@@ -541,7 +541,7 @@ TEST(BroadPhase, BatchesOfCellsGiveExactlyThePairsOfSingleRunsWithTheSameCycles)
 
 namespace {
 
-// Wraps a backend and records each batch's cell sizes as they reach it.
+// Wraps a backend and records each hand-over's cells (copies of their boxes) as they reach it.
 class BatchRecordingBackend final : public Backend {
  public:
   explicit BatchRecordingBackend(Backend& inner) : inner_(inner) {}
@@ -549,20 +549,17 @@ class BatchRecordingBackend final : public Backend {
   std::size_t capacity() const override { return inner_.capacity(); }
   bool bipartite() const override { return inner_.bipartite(); }
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override {
-    batches.push_back({boxes.size()});
+    batches.push_back({{boxes.begin(), boxes.end()}});
     inner_.run(boxes, out, stats);
   }
   using Backend::runBatch;
   void runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
                 std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) override {
-    std::vector<std::size_t>& sizes = batches.emplace_back();
-    for (const auto& cell : cells) sizes.push_back(cell.size());
-    auto& copies = cellBoxes.emplace_back();
+    auto& copies = batches.emplace_back();
     for (const auto& cell : cells) copies.emplace_back(cell.begin(), cell.end());
     inner_.runBatch(cells, splits, out, cellEnds, stats);
   }
-  std::vector<std::vector<std::size_t>> batches;
-  std::vector<std::vector<std::vector<KeyBox>>> cellBoxes;
+  std::vector<std::vector<std::vector<KeyBox>>> batches;
 
  private:
   Backend& inner_;
@@ -586,10 +583,11 @@ TEST(BroadPhase, BatchesReachTheDeviceInAscendingCellSizeSoThatTheirLoadsHide) {
       bool someBatchWasOutOfOrder = false;
       RunStats ascending, descending;
       for (std::size_t b = 0; b < recording.batches.size(); ++b) {
-        const auto& sizes = recording.batches[b];
+        std::vector<std::size_t> sizes;
+        for (const auto& cell : recording.batches[b]) sizes.push_back(cell.size());
         EXPECT_TRUE(std::is_sorted(sizes.begin(), sizes.end())) << label << " batch " << b;
         // The same cells largest first: each cell's loads now outlast the run before.
-        std::vector<std::span<const KeyBox>> inOrder(recording.cellBoxes[b].begin(), recording.cellBoxes[b].end());
+        std::vector<std::span<const KeyBox>> inOrder(recording.batches[b].begin(), recording.batches[b].end());
         std::vector<std::span<const KeyBox>> reversed(inOrder.rbegin(), inOrder.rend());
         std::vector<Pair> scratch;
         std::vector<std::size_t> ends;
