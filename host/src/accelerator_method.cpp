@@ -22,7 +22,9 @@ AcceleratorMethod::AcceleratorMethod(std::shared_ptr<const DeviceConfig> device,
                                      PartitionKind partition)
     : device_(std::move(device)),
       backend_(device_->makeBackend()),
-      phase_(*backend_, cellSize, device_->cellsPerBatch, partition) {}
+      phase_(*backend_, cellSize, device_->cellsPerBatch, partition) {
+  if (device_->firstBatchCells) phase_.setFirstBatchCells(device_->firstBatchCells);
+}
 
 FrameTime AcceleratorMethod::frameTime(double measuredSeconds) const {
   ModelledParts p;

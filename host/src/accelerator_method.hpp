@@ -56,6 +56,9 @@ struct DeviceConfig {
   /// Cells per hand-over to the device (the hardware's batch front end);
   /// 1 hands each cell over on its own, as before batches existed.
   std::size_t cellsPerBatch = 1;
+  /// Cells of a frame's first hand-over, doubling up to cellsPerBatch
+  /// (BroadPhase::setFirstBatchCells); 0: every hand-over holds cellsPerBatch.
+  std::size_t firstBatchCells = 0;
 };
 
 /// BroadPhase on the device: host part measured, device and link modelled.

@@ -125,6 +125,8 @@ nlohmann::json describe(const LineUpConfig& config) {
     j["link_model"] = {{"bandwidth_bytes_per_second", d->link.bandwidthBytesPerSecond},
                        {"latency_seconds_per_run", d->link.latencySecondsPerRun},
                        {"cells_per_batch", d->cellsPerBatch},
+                       {"first_batch_cells", d->firstBatchCells ? std::min(d->firstBatchCells, d->cellsPerBatch)
+                                                                : d->cellsPerBatch},
                        {"bytes_per_box", LinkModel::kBytesPerBox},
                        {"bytes_per_result_beat", d->beatBytes},
                        {"formula", "transfer = batches * latency + max(0, box bytes / bandwidth - load cycles / clock) "
@@ -479,15 +481,21 @@ std::string Benchmark::table(const nlohmann::json& results) {
   };
 
   std::string legend = "accelerator = measured host + modelled device + modelled transfer";
-  if (cfg.contains("clock_hz"))
+  if (cfg.contains("clock_hz")) {
+    const auto perBatch = cfg["link_model"].value("cells_per_batch", std::size_t{1});
+    const auto first = cfg["link_model"].value("first_batch_cells", perBatch);
+    const std::string handOvers =
+        first < perBatch ? fmt::format("hand-over; a frame's first holds {} cells, each next twice as many up to {}",
+                                       first, perBatch)
+                         : fmt::format("hand-over of up to {} cells", perBatch);
     legend = fmt::format(
         "accelerator = measured host + modelled device ({:.1f} MHz, device cycles with loads, {} backend) + modelled "
-        "transfer ({:.1f} GB/s, {:.1f} us per hand-over of up to {} cells; boxes stream through the "
+        "transfer ({:.1f} GB/s, {:.1f} us per {}; boxes stream through the "
         "24-byte-a-cycle load port, so only the link's excess over one cycle a box counts)",
         cfg["clock_hz"].get<double>() / 1e6, cfg["accelerator_backend"].get<std::string>(),
         cfg["link_model"]["bandwidth_bytes_per_second"].get<double>() / 1e9,
-        cfg["link_model"]["latency_seconds_per_run"].get<double>() * 1e6,
-        cfg["link_model"].value("cells_per_batch", std::size_t{1}));
+        cfg["link_model"]["latency_seconds_per_run"].get<double>() * 1e6, handOvers);
+  }
   header("Median broad-phase time per frame, ms, one thread unless named (" + legend +
          "; ! = missed exact pairs; - = skipped, see below)");
   for (const auto& name : names) {

@@ -30,6 +30,8 @@ struct BroadPhase::Worker {
   Backend* backend = nullptr;
   std::unique_ptr<AsyncBackend> async;  // with asynchronous hand-overs: the backend on a thread of its own
   std::size_t cellsPerBatch = 1;
+  std::size_t firstBatchCells = 1;  // the frame's first hand-over (see BroadPhase::setFirstBatchCells)
+  std::size_t batchLimit = 1;       // cells that make the batch being filled full: doubles per hand-over
   // The device's thread is stopped (after its last batch) before the buffers it reads go.
   ~Worker() { async.reset(); }
   std::vector<KeyBox> gathered;         // a chunk pair's boxes, packed for the backend
@@ -173,7 +175,16 @@ BroadPhase::BroadPhase(const BackendFactory& makeBackend, std::optional<std::siz
 
 void BroadPhase::configureWorkers() {
   check();
-  for (auto& w : workers_) w->cellsPerBatch = cellsPerBatch_;
+  for (auto& w : workers_) {
+    w->cellsPerBatch = cellsPerBatch_;
+    w->firstBatchCells = std::min(firstBatchCells_ ? firstBatchCells_ : cellsPerBatch_, cellsPerBatch_);
+  }
+}
+
+void BroadPhase::setFirstBatchCells(std::size_t cells) {
+  if (cells < 1) throw std::invalid_argument("cells of the first batch must be at least 1");
+  firstBatchCells_ = cells;
+  configureWorkers();
 }
 
 BroadPhase::~BroadPhase() = default;
@@ -306,6 +317,7 @@ void BroadPhase::Worker::startFrame(Clock::time_point start) {
   backendSeconds = 0;
   frameStart = start;
   runs.clear();
+  batchLimit = firstBatchCells;
   // Left over only if a frame failed: the device must be done with it first.
   if (inFlightResult.valid()) inFlightResult.wait();
   filling.clear();
@@ -398,11 +410,12 @@ void BroadPhase::Worker::submit(std::span<const KeyBox> keys, std::span<const st
       filling.boxes.insert(filling.boxes.end(), packed.begin(), packed.end());
   }
   filling.cells.push_back(cell);
-  if (filling.cells.size() >= cellsPerBatch) flush();
+  if (filling.cells.size() >= batchLimit) flush();
 }
 
 void BroadPhase::Worker::flush() {
   if (filling.cells.empty()) return;
+  batchLimit = std::min(2 * batchLimit, cellsPerBatch);
   // The cells go in ascending size. A device that loads the next cell while
   // the current one runs (the stream's) hides those loads only under a run
   // about as long; in the partition's order a small cell before a large one

@@ -1,6 +1,7 @@
 #pragma once
 // A whole-scene broad phase: keys, optional partition (k-d tree or grid), chunking, backend runs.
 
+#include <algorithm>
 #include <chrono>
 #include <deque>
 #include <functional>
@@ -84,6 +85,14 @@ class BroadPhase {
   const Partition& partition() const { return *partition_; }
   std::size_t threads() const { return workers_.size(); }
   std::size_t cellsPerBatch() const { return cellsPerBatch_; }
+  /// Slow start: a frame's first hand-over holds at most `cells` cells (at
+  /// least 1), and each next one twice as many as the one before, up to
+  /// cellsPerBatch. The device gets its first cells as soon as the partition
+  /// has made a few, instead of after a whole batch's worth, and is kept busy
+  /// from then on while the host fills the growing batches. By default every
+  /// hand-over holds cellsPerBatch cells.
+  void setFirstBatchCells(std::size_t cells);
+  std::size_t firstBatchCells() const { return firstBatchCells_ ? std::min(firstBatchCells_, cellsPerBatch_) : cellsPerBatch_; }
   HandOvers handOvers() const { return handOvers_; }
   /// The last call's hand-overs to the backend (batches, or single runs) in
   /// order, with the measured host time at which each was ready and its
@@ -109,6 +118,7 @@ class BroadPhase {
   std::unique_ptr<Pool> pool_;  // only with more than one worker
   std::optional<std::size_t> cellSize_;
   std::size_t cellsPerBatch_;
+  std::size_t firstBatchCells_ = 0;  // 0: cellsPerBatch_
   HandOvers handOvers_ = HandOvers::Synchronous;
   std::size_t capacity_;
   std::unique_ptr<Partition> partition_;

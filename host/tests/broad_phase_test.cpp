@@ -603,6 +603,44 @@ TEST(BroadPhase, BatchesReachTheDeviceInAscendingCellSizeSoThatTheirLoadsHide) {
     }
 }
 
+TEST(BroadPhase, SlowStartHandsOverFewCellsFirstThenTwiceAsManyEachTimeUpToTheBatch) {
+  ModelBackend stream(8, 256, 3, 4, 64, true);
+  const std::vector<Aabb> boxes = scatteredBoxes(3000, 21, -40, 40, 0, 3);
+  const std::vector<Pair> exact = bruteForce(boxes);
+  for (const PartitionKind partition : {PartitionKind::UniformGrid, PartitionKind::KdTree})
+    for (const auto& [first, perBatch] : std::vector<std::pair<std::size_t, std::size_t>>{{3, 40}, {1, 64}, {9, 7}}) {
+      const std::string label = std::string(partitionName(partition)) + " first " + std::to_string(first) +
+                                " per batch " + std::to_string(perBatch);
+      BatchRecordingBackend recording(stream);
+      BroadPhase bp(recording, 32, perBatch, partition);
+      bp.setFirstBatchCells(first);
+      EXPECT_EQ(bp.firstBatchCells(), std::min(first, perBatch)) << label;
+      ModelBackend plainModel(8, 256, 3, 4, 64, true);
+      BroadPhase plain(plainModel, 32, perBatch, partition);
+      for (int frame = 0; frame < 2; ++frame) {  // each frame starts small again
+        recording.batches.clear();
+        std::vector<Pair> pairs, plainPairs;
+        bp.findPairs(boxes, pairs);
+        plain.findPairs(boxes, plainPairs);
+        EXPECT_EQ(sorted(pairs), exact) << label;
+        // Every cell still reaches the device once: the same runs and pair tests as full batches.
+        EXPECT_EQ(bp.stats().runs, plain.stats().runs) << label;
+        EXPECT_EQ(bp.stats().issueCycles, plain.stats().issueCycles) << label;
+        ASSERT_GT(recording.batches.size(), 4u) << label;
+        std::size_t expected = std::min(first, perBatch), cells = 0;
+        for (std::size_t b = 0; b + 1 < recording.batches.size(); ++b) {  // the last holds what is left
+          EXPECT_EQ(recording.batches[b].size(), expected) << label << " hand-over " << b;
+          cells += recording.batches[b].size();
+          expected = std::min(2 * expected, perBatch);
+        }
+        EXPECT_LE(recording.batches.back().size(), expected) << label;
+        EXPECT_EQ(cells + recording.batches.back().size(), bp.stats().runs) << label;
+        EXPECT_EQ(bp.runs().size(), recording.batches.size()) << label;
+      }
+    }
+  EXPECT_THROW(BroadPhase(stream, 32, 8).setFirstBatchCells(0), std::invalid_argument);
+}
+
 TEST(BroadPhase, BatchesWorkOnSeveralThreadsAndRejectZeroCellsPerBatch) {
   BroadPhase model([] { return std::make_unique<ModelBackend>(2, 6, 5); }, 16, 2, 5);
   for (std::size_t n : {0u, 2u, 300u, 1000u})

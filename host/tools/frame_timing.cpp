@@ -2,7 +2,8 @@
 // benchmark's scene (bouncing cube), outside the unit tests.
 //
 //   frame_timing [--objects 8000] [--cell-size 128] [--partition grid|kd] [--cells-per-batch 16]
-//                [--backend model|rtl|cpu] [--frames 30] [--passes 10] [--evict]
+//                [--first-batch-cells N ...] [--clock-mhz 100] [--backend model|rtl|cpu]
+//                [--frames 30] [--passes 10] [--evict]
 //
 // The scene is simulated once and its frames recorded; then every pass runs
 // BroadPhase over the recorded frames in order (as the benchmark hands them
@@ -11,6 +12,12 @@
 // backend, as the benchmark's accelerator rows count it. --evict touches a
 // buffer larger than the caches before each frame, as the benchmark's other
 // methods do between two frames of this one.
+//
+// Several --first-batch-cells values are timed side by side: every frame runs
+// each configuration in turn (in a rotating order), so that the machine's
+// drift over a run falls on all of them alike. Each also prints the MODELLED
+// overlapped frame (modelPipeline: the measured ready and decode times, the
+// device's cycles at --clock-mhz, the benchmark's link model).
 
 #include <algorithm>
 #include <chrono>
@@ -27,6 +34,7 @@
 #include "exact_pairs.hpp"
 #include "rtl_backend.hpp"
 #include "scene.hpp"
+#include "timeline.hpp"
 
 // Heap allocations, counted to report those a frame makes (a frame should
 // reuse its buffers). Global only in this driver, for the replaced operator new.
@@ -56,11 +64,18 @@ int main(int argc, char** argv) {
   CLI::App app{"Host work per frame of the accelerator method, by part, on the benchmark's scene"};
   std::size_t objects = 8000, cellSize = 128, cellsPerBatch = 16, frames = 30, passes = 10;
   std::string partition = "grid", backendName = "model";
+  std::vector<std::size_t> firstBatchCells;
+  double clockMHz = 100;
   bool evict = false;
   app.add_option("--objects", objects)->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--cell-size", cellSize)->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--partition", partition)->capture_default_str()->check(CLI::IsMember({"kd", "grid"}));
   app.add_option("--cells-per-batch", cellsPerBatch)->capture_default_str()->check(CLI::PositiveNumber);
+  app.add_option("--first-batch-cells", firstBatchCells,
+                 "Cells of each frame's first hand-over (BroadPhase::setFirstBatchCells); several: compared")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--clock-mhz", clockMHz, "Device clock of the modelled overlapped frame")->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--backend", backendName)->capture_default_str()->check(CLI::IsMember({"model", "rtl", "cpu"}));
   app.add_option("--frames", frames, "Frames recorded (each timed once a pass)")->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -81,47 +96,82 @@ int main(int argc, char** argv) {
   std::vector<std::vector<bpaccel::Pair>> exact(frames);
   for (std::size_t f = 0; f < frames; ++f) bpaccel::exactPairs(recorded[f], exact[f]);
 
-  std::unique_ptr<bpaccel::Backend> backend;
-  if (backendName == "rtl")
-    backend = std::make_unique<bpaccel::RtlBackend>();
-  else if (backendName == "cpu")  // software all-pairs: the host's own parts stand out in a profile
-    backend = std::make_unique<bpaccel::CpuBackend>();
-  else
-    backend = std::make_unique<bpaccel::ModelBackend>(bpaccel::modelOfBuiltHardware());
-  bpaccel::BroadPhase phase(*backend, cellSize, cellsPerBatch, bpaccel::parsePartitionKind(partition));
+  if (firstBatchCells.empty()) firstBatchCells.push_back(cellsPerBatch);
+  const auto makeBackend = [&]() -> std::unique_ptr<bpaccel::Backend> {
+    if (backendName == "rtl") return std::make_unique<bpaccel::RtlBackend>();
+    if (backendName == "cpu")  // software all-pairs: the host's own parts stand out in a profile
+      return std::make_unique<bpaccel::CpuBackend>();
+    return std::make_unique<bpaccel::ModelBackend>(bpaccel::modelOfBuiltHardware());
+  };
+  // One configuration: its backend, its broad phase and its figures.
+  struct Timed {
+    std::unique_ptr<bpaccel::Backend> backend;
+    std::unique_ptr<bpaccel::BroadPhase> phase;
+    std::vector<double> host, convert, part, cells, decode, pipelined, allocations;  // allocations: after the first pass
+  };
+  std::vector<Timed> timed;
+  for (const std::size_t first : firstBatchCells) {
+    Timed t;
+    t.backend = makeBackend();
+    t.phase = std::make_unique<bpaccel::BroadPhase>(*t.backend, cellSize, cellsPerBatch,
+                                                    bpaccel::parsePartitionKind(partition));
+    t.phase->setFirstBatchCells(first);
+    timed.push_back(std::move(t));
+  }
+  const bpaccel::PipelineModel model{clockMHz * 1e6};
 
   std::vector<char> flood(evict ? 64u << 20 : 0);
-  std::vector<double> host, convert, part, cells, decode, allocations;  // allocations: after the first pass
   std::vector<bpaccel::Pair> pairs;
   unsigned sink = 0;
+  std::size_t turn = 0;
   for (std::size_t p = 0; p < passes; ++p) {
-    for (std::size_t f = 0; f < frames; ++f) {
-      for (std::size_t b = 0; b < flood.size(); b += 64) sink += static_cast<unsigned char>(++flood[b]);
-      const std::size_t allocationsBefore = gAllocations;
-      const auto t0 = Clock::now();
-      phase.findPairs(recorded[f], pairs);
-      const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
-      const auto& t = phase.times();
-      host.push_back(wall - t.backendSeconds);
-      if (p > 0) allocations.push_back(static_cast<double>(gAllocations - allocationsBefore));
-      convert.push_back(t.convertSeconds);
-      part.push_back(t.partitionSeconds);
-      cells.push_back(t.cellsSeconds - t.backendSeconds);
-      double decoded = 0;
-      for (const auto& r : phase.runs()) decoded += r.decodeSeconds;
-      decode.push_back(decoded);
-      std::sort(pairs.begin(), pairs.end());
-      if (pairs != exact[f]) {
-        fmt::print(stderr, "frame_timing: frame {} pass {}: {} pairs, the exact set has {}\n", f, p, pairs.size(),
-                   exact[f].size());
-        return 1;
+    for (std::size_t f = 0; f < frames; ++f, ++turn) {
+      for (std::size_t k = 0; k < timed.size(); ++k) {
+        Timed& t = timed[(k + turn) % timed.size()];
+        for (std::size_t b = 0; b < flood.size(); b += 64) sink += static_cast<unsigned char>(++flood[b]);
+        const std::size_t allocationsBefore = gAllocations;
+        const auto t0 = Clock::now();
+        t.phase->findPairs(recorded[f], pairs);
+        const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+        const auto& times = t.phase->times();
+        const double hostSeconds = wall - times.backendSeconds;
+        t.host.push_back(hostSeconds);
+        if (p > 0) t.allocations.push_back(static_cast<double>(gAllocations - allocationsBefore));
+        t.convert.push_back(times.convertSeconds);
+        t.part.push_back(times.partitionSeconds);
+        t.cells.push_back(times.cellsSeconds - times.backendSeconds);
+        double decoded = 0;
+        for (const auto& r : t.phase->runs()) decoded += r.decodeSeconds;
+        t.decode.push_back(decoded);
+        t.pipelined.push_back(bpaccel::modelPipeline(t.phase->runs(), hostSeconds, model).frameSeconds);
+        std::sort(pairs.begin(), pairs.end());
+        if (pairs != exact[f]) {
+          fmt::print(stderr, "frame_timing: frame {} pass {}: {} pairs, the exact set has {}\n", f, p, pairs.size(),
+                     exact[f].size());
+          return 1;
+        }
       }
     }
   }
   const auto us = [](const std::vector<double>& v) { return median(v) * 1e6; };
   fmt::print("objects {} partition {} cell {} cells/batch {} backend {} frames {} evict {} (sink {})\n", objects,
-             partition, cellSize, cellsPerBatch, backend->name(), host.size(), evict, sink & 1);
-  fmt::print("host_us {:.1f} convert_us {:.1f} partition_us {:.1f} cells_host_us {:.1f} (decode_us {:.1f}) pairs {} hits {} runs {} batches {} allocations/frame {}\n",
-             us(host), us(convert), us(part), us(cells), us(decode), pairs.size(), phase.stats().hits, phase.stats().runs, phase.stats().batches, median(allocations));
+             partition, cellSize, cellsPerBatch, timed.front().backend->name(), timed.front().host.size(), evict,
+             sink & 1);
+  for (std::size_t k = 0; k < timed.size(); ++k) {
+    const Timed& t = timed[k];
+    const auto& stats = t.phase->stats();
+    fmt::print("first_batch_cells {} host_us {:.1f} convert_us {:.1f} partition_us {:.1f} cells_host_us {:.1f} "
+               "(decode_us {:.1f}) pipelined_us_modelled {:.1f} at {} MHz; pairs {} hits {} runs {} batches {} "
+               "device_cycles {} allocations/frame {}\n",
+               t.phase->firstBatchCells(), us(t.host), us(t.convert), us(t.part), us(t.cells), us(t.decode),
+               us(t.pipelined), clockMHz, pairs.size(), stats.hits, stats.runs, stats.batches, stats.deviceCycles(),
+               median(t.allocations));
+    if (k > 0) {  // paired with the first configuration, frame by frame
+      std::vector<double> ratio;
+      for (std::size_t i = 0; i < t.pipelined.size(); ++i) ratio.push_back(t.pipelined[i] / timed[0].pipelined[i]);
+      fmt::print("  overlapped frame against first_batch_cells {}: median ratio {:.3f}\n",
+                 timed[0].phase->firstBatchCells(), median(ratio));
+    }
+  }
   return 0;
 }
