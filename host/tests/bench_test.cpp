@@ -416,8 +416,9 @@ TEST(AcceleratorMethod, DeviceTimeCountsLoadCycles) {
 
 TEST(AcceleratorMethod, BatchesPayTheLinkLatencyOncePerHandOverAndFindTheSamePairs) {
   const auto boxes = bpaccel::testing::adversarialScenes(1500, 4)[0].second;
-  const auto frame = [&](std::size_t cellsPerBatch, std::vector<Pair>& pairs) {
+  const auto frame = [&](std::size_t cellsPerBatch, std::vector<Pair>& pairs, std::size_t firstBatchCells = 0) {
     auto d = std::make_shared<DeviceConfig>();
+    d->firstBatchCells = firstBatchCells;
     d->makeBackend = [] { return std::make_unique<ModelBackend>(modelOfBuiltHardware()); };
     d->clockHz = 100e6;
     d->link.bandwidthBytesPerSecond = 1e12;  // the load port is slower: boxes add no link time
@@ -438,6 +439,16 @@ TEST(AcceleratorMethod, BatchesPayTheLinkLatencyOncePerHandOverAndFindTheSamePai
   EXPECT_EQ(eight.stats.issueCycles, one.stats.issueCycles);
   EXPECT_NEAR(one.transferSeconds - eight.transferSeconds,
               static_cast<double>(one.stats.batches - eight.stats.batches) * 1e-6, 1e-12);
+
+  // Slow start: hand-overs of 2, 4, then 8 cells.
+  std::vector<Pair> slowStarted;
+  const ModelledParts slow = frame(8, slowStarted, 2);
+  EXPECT_EQ(bpaccel::testing::sorted(slowStarted), bpaccel::testing::sorted(single));
+  EXPECT_EQ(slow.stats.runs, one.stats.runs);
+  EXPECT_EQ(slow.stats.issueCycles, one.stats.issueCycles);
+  EXPECT_EQ(slow.stats.batches, 2 + (one.stats.runs - 6 + 7) / 8);
+  EXPECT_NEAR(slow.transferSeconds - eight.transferSeconds,
+              static_cast<double>(slow.stats.batches - eight.stats.batches) * 1e-6, 1e-12);
 }
 
 TEST(DeviceClock, TheDefaultClockIsTheFmaxOfAReportOfTheSameMAndArchitectureOnly) {
