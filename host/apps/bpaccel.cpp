@@ -110,7 +110,7 @@ std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, do
   auto device = std::make_shared<bpaccel::DeviceConfig>();
   device->backend = backend;
   device->makeBackend = [backend] { return makeBackend(backend); };
-  device->beatBytes = (2 * BPACCEL_INDEX_WIDTH + BPACCEL_M + 7) / 8;  // {iBase, jBase, mask[m]} in bytes
+  device->beatBytes = bpaccel::resultBeatBytesOfBuiltHardware();
   device->hardware = {{"m", BPACCEL_M},
                       {"capacity", BPACCEL_CAPACITY},
                       {"key_width", BPACCEL_KEY_WIDTH},

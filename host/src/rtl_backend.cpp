@@ -90,6 +90,8 @@ ModelBackend modelOfBuiltHardware() {
                       BPACCEL_BATCH_CELLS, BPACCEL_BATCH_OVERLAPS_LOADS != 0);
 }
 
+std::size_t resultBeatBytesOfBuiltHardware() { return (2 * BPACCEL_INDEX_WIDTH + BPACCEL_M + 7) / 8; }
+
 void RtlBackend::settle() {
   top_->clock = 0;
   top_->eval();

@@ -65,5 +65,7 @@ class RtlBackend final : public Backend {
 
 /// The C++ model of exactly the hardware this host was built with.
 ModelBackend modelOfBuiltHardware();
+/// Bytes of one result beat of that hardware ({iBase, jBase, mask[m]}), for the link model.
+std::size_t resultBeatBytesOfBuiltHardware();
 
 }  // namespace bpaccel

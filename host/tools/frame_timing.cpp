@@ -17,7 +17,7 @@
 // each configuration in turn (in a rotating order), so that the machine's
 // drift over a run falls on all of them alike. Each also prints the MODELLED
 // overlapped frame (modelPipeline: the measured ready and decode times, the
-// device's cycles at --clock-mhz, the benchmark's link model).
+// device's cycles at --clock-mhz, the benchmark's default link model).
 
 #include <algorithm>
 #include <chrono>
@@ -118,7 +118,9 @@ int main(int argc, char** argv) {
     t.phase->setFirstBatchCells(first);
     timed.push_back(std::move(t));
   }
-  const bpaccel::PipelineModel model{clockMHz * 1e6};
+  bpaccel::PipelineModel model;  // the benchmark's link model (--link-gbytes-per-s 4, --link-latency-us 1)
+  model.clockHz = clockMHz * 1e6;
+  model.bytesPerBeat = static_cast<double>(bpaccel::resultBeatBytesOfBuiltHardware());
 
   std::vector<char> flood(evict ? 64u << 20 : 0);
   std::vector<bpaccel::Pair> pairs;
