@@ -747,6 +747,10 @@ TEST(BroadPhase, AsynchronousHandOversGiveTheSynchronousPairsCountersAndRecords)
           BroadPhase async([] { return std::make_unique<ModelBackend>(2, 64, 5); }, 16, 1, perBatch, partition,
                            HandOvers::Asynchronous);
           EXPECT_EQ(async.handOvers(), HandOvers::Asynchronous);
+          if (perBatch == 64) {  // with a slow start (hand-overs of 3, 6, 12, ...) on both
+            sync.setFirstBatchCells(3);
+            async.setFirstBatchCells(3);
+          }
           for (int frame = 0; frame < 2; ++frame) {  // the second frame reuses the in-flight buffers
             std::vector<Pair> expected, pairs;
             sync.findPairs(boxes, expected);
