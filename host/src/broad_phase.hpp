@@ -92,7 +92,9 @@ class BroadPhase {
   /// from then on while the host fills the growing batches. By default every
   /// hand-over holds cellsPerBatch cells.
   void setFirstBatchCells(std::size_t cells);
-  std::size_t firstBatchCells() const { return firstBatchCells_ ? std::min(firstBatchCells_, cellsPerBatch_) : cellsPerBatch_; }
+  std::size_t firstBatchCells() const {
+    return firstBatchCells_ ? std::min(firstBatchCells_, cellsPerBatch_) : cellsPerBatch_;
+  }
   HandOvers handOvers() const { return handOvers_; }
   /// The last call's hand-overs to the backend (batches, or single runs) in
   /// order, with the measured host time at which each was ready and its

@@ -107,7 +107,8 @@ int main(int argc, char** argv) {
   struct Timed {
     std::unique_ptr<bpaccel::Backend> backend;
     std::unique_ptr<bpaccel::BroadPhase> phase;
-    std::vector<double> host, convert, part, cells, decode, pipelined, allocations;  // allocations: after the first pass
+    std::vector<double> host, convert, part, cells, decode, pipelined;
+    std::vector<double> allocations;  // after the first pass
   };
   std::vector<Timed> timed;
   for (const std::size_t first : firstBatchCells) {
