@@ -37,8 +37,18 @@ object EmitVerilog {
       )
   }
 
-  /** firtool options that keep the output plain enough for Yosys, Verilator and vendor tools. */
+  /** firtool options that keep the output plain enough for Yosys, Verilator and vendor tools.
+    *
+    * `--emit-separate-always-blocks`: firtool 1.62.1, merging the always
+    * blocks of sibling registers, now and then put a register's assignment
+    * under another's enable (StreamEngine: the start's copy into window lane
+    * 0 under `headShift_replica8`): from one CHIRRTL file, 1 in 24 and 8 in
+    * 36 runs of firtool gave a different StreamEngine.sv, and a CI build of
+    * such a file computed wrong pairs. With the option, 60 runs gave one
+    * file, with each copy under its own `headCopy` enable.
+    */
   val firtoolOptions: Array[String] = Array(
+    "--emit-separate-always-blocks",
     "-disable-all-randomization",
     "-strip-debug-info",
     "--lowering-options=disallowLocalVariables,disallowPackedArrays,locationInfoStyle=none"

@@ -579,9 +579,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     // each holds 0 in the cycle after a reset cycle, `next` of the last one otherwise.
     val gated = next && !reset.asBool
     Seq.tabulate(copies) { k =>
-      // dontTouch: firtool once merged a headCopy copy into a headShift one
-      // (an emission that computed wrong pairs); nothing may merge them.
-      val copy = dontTouch(RegNext(gated).suggestName(s"${name}_replica$k"))
+      val copy = RegNext(gated).suggestName(s"${name}_replica$k")
       assert(copy === now || unless, s"the look-ahead of $name is wrong")
       copy
     }
