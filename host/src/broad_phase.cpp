@@ -177,7 +177,7 @@ void BroadPhase::configureWorkers() {
   check();
   for (auto& w : workers_) {
     w->cellsPerBatch = cellsPerBatch_;
-    w->firstBatchCells = std::min(firstBatchCells_ ? firstBatchCells_ : cellsPerBatch_, cellsPerBatch_);
+    w->firstBatchCells = firstBatchCells();
   }
 }
 
