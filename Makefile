@@ -28,11 +28,15 @@ FPGA_MEMORY_STYLE ?= $(FPGA_DEFAULT_MEMORY_STYLE)
 # Folders and reports of the seed architecture keep their names; others get the architecture as prefix.
 ARCH_PREFIX := $(if $(filter seed,$(ARCH)),,$(ARCH)-)
 VERILOG_DIR ?= generated/$(ARCH_PREFIX)m$(M)
-FPGA_NAME := $(ARCH_PREFIX)m$(M)$(if $(filter $(FPGA_DEFAULT_MEMORY_STYLE),$(FPGA_MEMORY_STYLE)),,-$(FPGA_MEMORY_STYLE))
+# Folders and reports of a key width other than 32 get it as suffix (-k16).
+KEY_SUFFIX := $(if $(filter 32,$(KEY_WIDTH)),,-k$(KEY_WIDTH))
+FPGA_NAME := $(ARCH_PREFIX)m$(M)$(KEY_SUFFIX)$(if $(filter $(FPGA_DEFAULT_MEMORY_STYLE),$(FPGA_MEMORY_STYLE)),,-$(FPGA_MEMORY_STYLE))
 
-# The host is built for one configuration: ARCH, M and CAPACITY above.
-HOST_VERILOG := build/verilog/$(ARCH_PREFIX)m$(M)-c$(CAPACITY)
-HOST_BUILD   := build/host-$(ARCH_PREFIX)m$(M)-c$(CAPACITY)
+# The host is built for one configuration: ARCH, M, CAPACITY and KEY_WIDTH
+# above (a device with narrower keys gets each cell's keys narrowed and the
+# host checks its pairs with the full keys; docs/host.md).
+HOST_VERILOG := build/verilog/$(ARCH_PREFIX)m$(M)-c$(CAPACITY)$(KEY_SUFFIX)
+HOST_BUILD   := build/host-$(ARCH_PREFIX)m$(M)-c$(CAPACITY)$(KEY_SUFFIX)
 # Where the bpaccel CLI goes; the benchmark's configuration gets its own.
 HOST_BIN_DIR ?= build/bin
 SCALA_SOURCES := $(wildcard src/bpaccel/*.scala) build.sbt
@@ -68,7 +72,7 @@ formal-long: deps
 
 # The C++ host (build/bin/bpaccel) with the Verilated accelerator, and its tests.
 $(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
-	$(SBT) "runMain bpaccel.EmitVerilog --arch $(ARCH) --m $(M) --capacity $(CAPACITY) --key-width 32 --target-dir $(HOST_VERILOG)"
+	$(SBT) "runMain bpaccel.EmitVerilog --arch $(ARCH) --m $(M) --capacity $(CAPACITY) --key-width $(KEY_WIDTH) --target-dir $(HOST_VERILOG)"
 
 host: deps $(HOST_VERILOG)/filelist.f
 	cmake -S host -B $(HOST_BUILD) -G Ninja -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BIN_DIR=$(abspath $(HOST_BIN_DIR))
@@ -112,7 +116,7 @@ bench-large-run: host
 
 # The same host, Verilated model and tests under AddressSanitizer and
 # UndefinedBehaviorSanitizer (host/cmake/sanitize.cmake); any report fails.
-HOST_SANITIZE_BUILD := build/host-asan-$(ARCH_PREFIX)m$(M)-c$(CAPACITY)
+HOST_SANITIZE_BUILD := build/host-asan-$(ARCH_PREFIX)m$(M)-c$(CAPACITY)$(KEY_SUFFIX)
 SANITIZER_ENV := ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1:strict_init_order=1 \
                  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 host-sanitize: deps $(HOST_VERILOG)/filelist.f

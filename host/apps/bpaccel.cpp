@@ -111,6 +111,7 @@ std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, do
   device->backend = backend;
   device->makeBackend = [backend] { return makeBackend(backend); };
   device->beatBytes = bpaccel::resultBeatBytesOfBuiltHardware();
+  device->link.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytesOfBuiltHardware());
   device->hardware = {{"m", BPACCEL_M},
                       {"capacity", BPACCEL_CAPACITY},
                       {"key_width", BPACCEL_KEY_WIDTH},

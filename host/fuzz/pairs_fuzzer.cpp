@@ -11,6 +11,7 @@
 // Input layout (read front to back; missing bytes read as 0), so seeds can be
 // written by hand (host/fuzz/README.md):
 //   cell byte: 0 = no partition, else cell size 1 + (byte - 1) % 40 (k-d tree and grid)
+//   and the model's key width 32, 16, 4 or 1 by ((byte - 1) / 40) % 4 (no partition: 32)
 //   m byte: model lanes 1 + byte % 8; bits 3-4: the model's cells per hand-over
 //   1 + 3 * bits (1, 4, 7, 10); bits 5-6: its hardware batch 1 + bits cells
 //   (a hand-over beyond it is split); with bit 7 set the model with the k-d
@@ -191,6 +192,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint8_t cellByte = in.byte();
   const std::optional<std::size_t> cell =
       cellByte == 0 ? std::nullopt : std::optional<std::size_t>(1 + (cellByte - 1) % 40);
+  // The model device's key width, from the same byte's quotient: below 32 the
+  // broad phase narrows each cell's keys and checks the pairs with the full ones.
+  constexpr unsigned kKeyWidths[] = {32, 16, 4, 1};
+  const unsigned keyWidth = cellByte == 0 ? 32 : kKeyWidths[((cellByte - 1) / 40) % 4];
   const std::uint8_t mByte = in.byte();
   const std::size_t m = 1 + mByte % 8;
   const std::size_t threads = mByte & 0x80 ? 2 : 1;
@@ -204,33 +209,34 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::vector<Aabb> boxes = decodeScene(in);
 
   CpuBackend cpu;
-  ModelBackend model(m, capacity, /*runOverheadCycles=*/3, streamReadLatency, batchCells);
+  ModelBackend model(m, capacity, /*runOverheadCycles=*/3, streamReadLatency, batchCells, /*overlapsLoads=*/false,
+                     keyWidth);
   std::vector<Setup> setups;
   std::vector<std::optional<std::size_t>> cells{std::nullopt};
   if (cell) cells.push_back(cell);
   for (const auto& c : cells) {
     const std::string cellName = c ? std::to_string(*c) : "none";
     setups.push_back({"cpu cell " + cellName, [&cpu, c] { return std::make_unique<BroadPhase>(cpu, c); }});
-    setups.push_back({fmt::format("model {} m {} capacity {} cell {} batch {}/{}", arch, m, capacity, cellName,
-                                  cellsPerBatch, batchCells),
+    setups.push_back({fmt::format("model {} m {} capacity {} keys {} cell {} batch {}/{}", arch, m, capacity, keyWidth,
+                                  cellName, cellsPerBatch, batchCells),
                       [&model, c, cellsPerBatch] { return std::make_unique<BroadPhase>(model, c, cellsPerBatch); }});
   }
   if (cell) {
     setups.push_back({"cpu grid cell " + std::to_string(*cell), [&cpu, cell] {
                         return std::make_unique<BroadPhase>(cpu, cell, 1, PartitionKind::UniformGrid);
                       }});
-    setups.push_back({fmt::format("model {} m {} capacity {} grid cell {} batch {}/{}", arch, m, capacity, *cell,
-                                  cellsPerBatch, batchCells),
+    setups.push_back({fmt::format("model {} m {} capacity {} keys {} grid cell {} batch {}/{}", arch, m, capacity,
+                                  keyWidth, *cell, cellsPerBatch, batchCells),
                       [&model, cell, cellsPerBatch] {
                         return std::make_unique<BroadPhase>(model, cell, cellsPerBatch, PartitionKind::UniformGrid);
                       }});
   }
   if (threads > 1 && cell) {
-    const auto makeModel = [m, capacity, streamReadLatency, batchCells]() -> std::unique_ptr<Backend> {
-      return std::make_unique<ModelBackend>(m, capacity, 3, streamReadLatency, batchCells);
+    const auto makeModel = [m, capacity, streamReadLatency, batchCells, keyWidth]() -> std::unique_ptr<Backend> {
+      return std::make_unique<ModelBackend>(m, capacity, 3, streamReadLatency, batchCells, false, keyWidth);
     };
-    setups.push_back({fmt::format("model {} m {} capacity {} cell {} threads {} batch {}/{}", arch, m, capacity, *cell,
-                                  threads, cellsPerBatch, batchCells),
+    setups.push_back({fmt::format("model {} m {} capacity {} keys {} cell {} threads {} batch {}/{}", arch, m, capacity,
+                                  keyWidth, *cell, threads, cellsPerBatch, batchCells),
                       [makeModel, cell, threads, cellsPerBatch] {
                         return std::make_unique<BroadPhase>(makeModel, cell, threads, cellsPerBatch);
                       }});

@@ -9,7 +9,7 @@
 namespace bpaccel {
 
 double LinkModel::seconds(const RunStats& s, std::size_t bytesPerBeat, double clockHz) const {
-  const double boxLink = kBytesPerBox * static_cast<double>(s.boxesSent) / bandwidthBytesPerSecond;
+  const double boxLink = bytesPerBox * static_cast<double>(s.boxesSent) / bandwidthBytesPerSecond;
   // The load port takes one box a cycle, hidden under a run or not: the link costs extra only when slower.
   const double boxPort = static_cast<double>(s.boxesSent) / clockHz;
   const double results = static_cast<double>(bytesPerBeat * s.beatsReceived) / bandwidthBytesPerSecond;
@@ -34,7 +34,7 @@ FrameTime AcceleratorMethod::frameTime(double measuredSeconds) const {
   p.deviceSeconds = static_cast<double>(p.stats.deviceCycles()) / device_->clockHz;
   p.transferSeconds = device_->link.seconds(p.stats, device_->beatBytes, device_->clockHz);
   const PipelineModel model{device_->clockHz, device_->link.bandwidthBytesPerSecond, device_->link.latencySecondsPerRun,
-                            LinkModel::kBytesPerBox, static_cast<double>(device_->beatBytes)};
+                            device_->link.bytesPerBox, static_cast<double>(device_->beatBytes)};
   p.pipeline = std::make_shared<const FrameTimeline>(modelPipeline(phase_.runs(), p.hostSeconds, model));
   return {p.hostSeconds + p.deviceSeconds + p.transferSeconds, p};
 }

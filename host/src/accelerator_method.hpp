@@ -17,16 +17,16 @@
 namespace bpaccel {
 
 /// Modelled link between host and accelerator. Boxes stream through the
-/// device's load port, one 24-byte box a cycle, while they arrive: the load
+/// device's load port, one box a cycle (24 bytes with 32-bit keys), while they arrive: the load
 /// cycles are device time, and the link adds only what it is slower than the
 /// port. Each hand-over (a batch of cells, or a single run) pays a latency
 /// (command and completion); result beats come back over the link.
 ///   transfer = hand-overs * latency + max(0, box bytes / bandwidth - load cycles / clock)
 ///            + result bytes / bandwidth
 struct LinkModel {
-  static constexpr double kBytesPerBox = 24;
   double bandwidthBytesPerSecond = 4e9;  // a PCIe Gen3 x4 link's order of magnitude
   double latencySecondsPerRun = 1e-6;    // one command and one completion per hand-over
+  double bytesPerBox = 24;               // six keys of the device's key width
   double seconds(const RunStats& s, std::size_t bytesPerBeat, double clockHz) const;
 };
 

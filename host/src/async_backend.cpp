@@ -17,6 +17,7 @@ AsyncBackend::AsyncBackend(const DeviceFactory& makeDevice) {
       name_ = device->name();
       capacity_ = device->capacity();
       bipartite_ = device->bipartite();
+      keyWidth_ = device->keyWidth();
     } catch (...) {
       built.set_exception(std::current_exception());
       return;

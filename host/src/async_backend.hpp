@@ -49,6 +49,7 @@ class AsyncBackend {
   const std::string& name() const { return name_; }
   std::size_t capacity() const { return capacity_; }
   bool bipartite() const { return bipartite_; }
+  unsigned keyWidth() const { return keyWidth_; }
   /// Queues one hand-over of `cells` (each at most capacity() boxes), with
   /// their bipartite splits as Backend::runBatch takes them (empty: none).
   std::future<BatchResult> submit(std::span<const std::span<const KeyBox>> cells,
@@ -66,6 +67,7 @@ class AsyncBackend {
   std::string name_;
   std::size_t capacity_ = 0;
   bool bipartite_ = false;
+  unsigned keyWidth_ = 32;
   std::mutex mutex_;
   std::condition_variable_any jobReady_;
   std::deque<Job> jobs_;

@@ -29,6 +29,22 @@ void Backend::checkBipartite(std::size_t n, std::size_t split) const {
     throw std::invalid_argument(fmt::format("{}: bipartite split {} outside 1 .. n-1 (n = {})", name(), split, n));
 }
 
+void Backend::checkKeyWidth(std::span<const KeyBox> boxes) const {
+  const unsigned width = keyWidth();
+  if (width >= 32) return;
+  std::uint32_t any = 0;  // the OR of every key: one branch for the whole cell
+  for (const KeyBox& b : boxes)
+    for (int a = 0; a < 3; ++a) any |= b.min[a] | b.max[a];
+  if ((any >> width) == 0) return;
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    for (int a = 0; a < 3; ++a)
+      if (((boxes[i].min[a] | boxes[i].max[a]) >> width) != 0)
+        throw std::invalid_argument(
+            fmt::format("{}: box {} has a key wider than the device's {} bits on axis {} (min {:#x}, max {:#x}); "
+                        "narrow the keys first (narrowKeys)",
+                        name(), i, width, a, boxes[i].min[a], boxes[i].max[a]));
+}
+
 void Backend::checkSplits(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits) const {
   if (splits.empty()) return;
   if (splits.size() != cells.size())
@@ -59,13 +75,17 @@ void Backend::runBatch(std::span<const std::span<const KeyBox>> cells, std::span
 }
 
 ModelBackend::ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles,
-                           std::uint64_t streamReadLatency, std::size_t batchCells, bool overlapsLoads)
+                           std::uint64_t streamReadLatency, std::size_t batchCells, bool overlapsLoads,
+                           unsigned keyWidth)
     : m_(m),
       capacity_(capacity),
       overhead_(runOverheadCycles),
       streamReadLatency_(streamReadLatency),
       batchCells_(batchCells),
-      overlapsLoads_(overlapsLoads) {
+      overlapsLoads_(overlapsLoads),
+      keyWidth_(keyWidth) {
+  if (keyWidth < 1 || keyWidth > 32)
+    throw std::invalid_argument(fmt::format("model: key width {} outside 1 .. 32", keyWidth));
   // Only the seed architecture stripes objects over m memories.
   if (m == 0 || capacity < 2 || (streamReadLatency == 0 && capacity % m != 0))
     throw std::invalid_argument(fmt::format("model: invalid m = {} / capacity = {}", m, capacity));
@@ -116,6 +136,7 @@ void ModelBackend::runCell(std::span<const KeyBox> boxes, std::size_t split, std
                            RunStats& stats) const {
   const std::size_t n = boxes.size();
   if (n > capacity_) throw std::length_error(fmt::format("model: {} boxes exceed the capacity {}", n, capacity_));
+  checkKeyWidth(boxes);
   const std::size_t before = out.size();
   // Block b, window start s: lane k tests (b*m + k, s + k) while s + k < n,
   // exactly as the hardware's sequencer issues it. A beat is one cycle with a hit.

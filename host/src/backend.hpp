@@ -39,6 +39,11 @@ class Backend {
                 std::vector<std::size_t>& cellEnds, RunStats& stats) {
     runBatch(cells, {}, out, cellEnds, stats);
   }
+  /// Bits of each key the device compares (BPACCEL_KEY_WIDTH), at most 32.
+  /// Below 32 a caller narrows each cell's keys first (narrowKeys) and
+  /// checks the pairs it gets back with the full keys, as BroadPhase does;
+  /// keys wider than this are refused, never cut.
+  virtual unsigned keyWidth() const { return 32; }
   /// Whether runBipartite() exists here (the stream architecture's device and its model).
   virtual bool bipartite() const { return false; }
   /// One bipartite run (one run, one batch): appends only the overlapping
@@ -50,6 +55,9 @@ class Backend {
  protected:
   /// For implementations of runBipartite: throws unless bipartite() and 1 <= split < n.
   void checkBipartite(std::size_t n, std::size_t split) const;
+  /// For implementations: throws std::invalid_argument, naming the box, when
+  /// a key of `boxes` does not fit keyWidth() bits (nothing to check at 32).
+  void checkKeyWidth(std::span<const KeyBox> boxes) const;
   /// For implementations of runBatch: throws unless `splits` is empty or one
   /// per cell, each 0 or a split checkBipartite allows.
   void checkSplits(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits) const;
@@ -86,9 +94,11 @@ std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m, std::uint64_
 class ModelBackend final : public Backend {
  public:
   ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles,
-               std::uint64_t streamReadLatency = 0, std::size_t batchCells = 64, bool overlapsLoads = false);
+               std::uint64_t streamReadLatency = 0, std::size_t batchCells = 64, bool overlapsLoads = false,
+               unsigned keyWidth = 32);
   std::string name() const override { return "model"; }
   std::size_t capacity() const override { return capacity_; }
+  unsigned keyWidth() const override { return keyWidth_; }
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
   using Backend::runBatch;
   void runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
@@ -118,6 +128,7 @@ class ModelBackend final : public Backend {
   std::uint64_t streamReadLatency_;  // 0: the seed architecture
   std::size_t batchCells_;
   bool overlapsLoads_;
+  unsigned keyWidth_;
 };
 
 /// Software alone: all pairs of the batch with SIMD compares (AllPairsKernel),

@@ -127,7 +127,7 @@ nlohmann::json describe(const LineUpConfig& config) {
                        {"cells_per_batch", d->cellsPerBatch},
                        {"first_batch_cells", d->firstBatchCells ? std::min(d->firstBatchCells, d->cellsPerBatch)
                                                                 : d->cellsPerBatch},
-                       {"bytes_per_box", LinkModel::kBytesPerBox},
+                       {"bytes_per_box", d->link.bytesPerBox},
                        {"bytes_per_result_beat", d->beatBytes},
                        {"formula", "transfer = batches * latency + max(0, box bytes / bandwidth - load cycles / clock) "
                                    "+ result bytes / bandwidth; device = (load + compute + drain cycles) / clock"}};

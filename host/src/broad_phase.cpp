@@ -32,6 +32,11 @@ struct BroadPhase::Worker {
   std::size_t cellsPerBatch = 1;
   std::size_t firstBatchCells = 1;  // the frame's first hand-over (see BroadPhase::setFirstBatchCells)
   std::size_t batchLimit = 1;       // cells that make the batch being filled full: doubles per hand-over
+  // The device's key width (Backend::keyWidth). Below 32 each device cell
+  // gets narrowed keys (narrowKeys) and its pairs are checked with the full ones.
+  unsigned keyWidth = 32;
+  bool narrows() const { return keyWidth < 32; }
+  std::vector<KeyBox> narrowedRun;  // runNow's narrowed cell
   // The device's thread is stopped (after its last batch) before the buffers it reads go.
   ~Worker() { async.reset(); }
   std::vector<KeyBox> gathered;         // a chunk pair's boxes, packed for the backend
@@ -68,6 +73,10 @@ struct BroadPhase::Worker {
     std::vector<std::span<const KeyBox>> cellSpans;  // what the backend gets, made at the hand-over
     std::vector<std::span<const std::uint32_t>> cellItems;
     std::vector<std::size_t> splits;  // the cells' device splits, made at the hand-over; empty: none has one
+    // With a narrow device: the cells' narrowed keys back to back, and the
+    // spans the device gets instead of cellSpans (which decoding checks with).
+    std::vector<KeyBox> narrowed;
+    std::vector<std::span<const KeyBox>> narrowedSpans;
     void clear() {
       cells.clear();
       items.clear();
@@ -104,7 +113,10 @@ struct BroadPhase::Worker {
   // and recorded for the pipeline model, then `decode` of its pairs.
   template <typename Run, typename Decode>
   void handOver(Run&& run, Decode&& decode);
-  // Writes the kept pairs from `to` on (room for every one of `pairs`) and returns the end.
+  // Writes the kept pairs from `to` on (room for every one of `pairs`) and
+  // returns the end. kCheckOverlap: the device compared narrowed keys, so a
+  // pair is kept only where the full keys in `packed` overlap too.
+  template <bool kCheckOverlap>
   static Pair* keepPairs(std::span<const Pair> pairs, std::span<const std::uint32_t> items,
                          std::span<const KeyBox> packed, std::span<const std::uint8_t> below, const Cell* region,
                          std::size_t splitAt, int keep, Pair* to);
@@ -119,6 +131,13 @@ struct BroadPhase::Worker {
   void processCell(std::span<const KeyBox> keys, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
                    std::span<const std::uint8_t> below, const Cell* region, std::size_t capacity, bool lasting);
   bool bipartite() const { return async ? async->bipartite() : backend->bipartite(); }
+  // The batch's cells as the device gets them: narrowed where it needs it.
+  std::span<const std::span<const KeyBox>> deviceCells(Batch& batch);
+  Pair* keepOwned(std::span<const Pair> pairs, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
+             std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep, Pair* to) const {
+    return narrows() ? keepPairs<true>(pairs, items, packed, below, region, splitAt, keep, to)
+                     : keepPairs<false>(pairs, items, packed, below, region, splitAt, keep, to);
+  }
 };
 
 /// The threads of a multi-threaded BroadPhase: an arena of its own, so the
@@ -178,6 +197,7 @@ void BroadPhase::configureWorkers() {
   for (auto& w : workers_) {
     w->cellsPerBatch = cellsPerBatch_;
     w->firstBatchCells = firstBatchCells();
+    w->keyWidth = w->async ? w->async->keyWidth() : w->backend->keyWidth();
   }
 }
 
@@ -453,7 +473,9 @@ void BroadPhase::Worker::flush() {
     local.clear();
     cellEnds.clear();
     handOver(
-        [&](RunStats& runStats) { backend->runBatch(filling.cellSpans, filling.splits, local, cellEnds, runStats); },
+        [&](RunStats& runStats) {
+          backend->runBatch(deviceCells(filling), filling.splits, local, cellEnds, runStats);
+        },
         [&] { decodeBatch(filling, local, cellEnds); });
     filling.clear();
     return;
@@ -464,7 +486,7 @@ void BroadPhase::Worker::flush() {
   // device holds stay valid) and `filling` takes the decoded one's storage.
   RunRecord record;
   record.readySeconds = seconds(frameStart, Clock::now()) - backendSeconds;
-  std::future<BatchResult> result = async->submit(filling.cellSpans, filling.splits);
+  std::future<BatchResult> result = async->submit(deviceCells(filling), filling.splits);
   try {
     collect();
   } catch (...) {
@@ -515,7 +537,7 @@ void BroadPhase::Worker::decodeBatch(const Batch& batch, std::span<const Pair> p
   for (std::size_t k = 0; k < batch.cells.size(); ++k) {
     const PendingCell& cell = batch.cells[k];
     const std::size_t c = batch.position[k], from = c == 0 ? 0 : ends[c - 1];
-    to = keepPairs(pairs.subspan(from, ends[c] - from), batch.cellItems[c], batch.cellSpans[c], cell.below,
+    to = keepOwned(pairs.subspan(from, ends[c] - from), batch.cellItems[c], batch.cellSpans[c], cell.below,
                    cell.hasRegion ? &cell.region : nullptr, cell.splitAt, cell.keep, to);
   }
   keptUntil(to);
@@ -529,15 +551,37 @@ void BroadPhase::Worker::runNow(std::span<const KeyBox> keys, std::span<const st
     for (std::size_t t = 0; t < items.size(); ++t) gathered[t] = keys[items[t]];
     packed = gathered;
   }
+  std::span<const KeyBox> toDevice = packed;
+  if (narrows()) {
+    narrowedRun.resize(packed.size());
+    narrowKeys(packed, keyWidth, narrowedRun);
+    toDevice = narrowedRun;
+  }
   local.clear();
   handOver(
       [&](RunStats& runStats) {
         if (deviceSplit == 0)
-          backend->run(packed, local, runStats);
+          backend->run(toDevice, local, runStats);
         else
-          backend->runBipartite(packed, deviceSplit, local, runStats);
+          backend->runBipartite(toDevice, deviceSplit, local, runStats);
       },
-      [&] { keptUntil(keepPairs(local, items, packed, below, region, splitAt, keep, roomFor(local.size()))); });
+      [&] { keptUntil(keepOwned(local, items, packed, below, region, splitAt, keep, roomFor(local.size()))); });
+}
+
+std::span<const std::span<const KeyBox>> BroadPhase::Worker::deviceCells(Batch& batch) {
+  if (!narrows()) return batch.cellSpans;
+  std::size_t total = 0;
+  for (const auto& cell : batch.cellSpans) total += cell.size();
+  batch.narrowed.resize(total);  // before any span into it is taken
+  batch.narrowedSpans.clear();
+  std::size_t at = 0;
+  for (const auto& cell : batch.cellSpans) {
+    const std::span<KeyBox> to(batch.narrowed.data() + at, cell.size());
+    narrowKeys(cell, keyWidth, to);
+    batch.narrowedSpans.emplace_back(to);
+    at += cell.size();
+  }
+  return batch.narrowedSpans;
 }
 
 template <typename Run, typename Decode>
@@ -559,6 +603,7 @@ void BroadPhase::Worker::handOver(Run&& run, Decode&& decode) {
 // and only those whose reference point lies in the cell's region: for a
 // whole cell with the partition's below() bits, decided from two bytes
 // instead of two boxes; else from the boxes (chunks pass no bits).
+template <bool kCheckOverlap>
 Pair* BroadPhase::Worker::keepPairs(std::span<const Pair> pairs, std::span<const std::uint32_t> items,
                                     std::span<const KeyBox> packed, std::span<const std::uint8_t> below,
                                     const Cell* region, std::size_t splitAt, int keep, Pair* to) {
@@ -572,7 +617,10 @@ Pair* BroadPhase::Worker::keepPairs(std::span<const Pair> pairs, std::span<const
     for (const auto& [a, b] : pairs) {
       const std::uint32_t i = ids[a], j = ids[b];
       *to = {std::min(i, j), std::max(i, j)};
-      to += ownsPair(bits[a], bits[b]);
+      if constexpr (kCheckOverlap)
+        to += static_cast<int>(ownsPair(bits[a], bits[b])) & static_cast<int>(overlaps(packed[a], packed[b]));
+      else
+        to += ownsPair(bits[a], bits[b]);
     }
     return to;
   }
@@ -582,7 +630,9 @@ Pair* BroadPhase::Worker::keepPairs(std::span<const Pair> pairs, std::span<const
     const bool owned = !region || region->contains(referencePoint(packed[a], packed[b]));
     const std::uint32_t i = ids[a], j = ids[b];
     *to = {std::min(i, j), std::max(i, j)};
-    to += static_cast<int>((keep & kind) != 0) & static_cast<int>(owned);
+    int kept = static_cast<int>((keep & kind) != 0) & static_cast<int>(owned);
+    if constexpr (kCheckOverlap) kept &= static_cast<int>(overlaps(packed[a], packed[b]));
+    to += kept;
   }
   return to;
 }

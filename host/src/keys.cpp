@@ -298,4 +298,29 @@ KeyBounds boundsOf(std::span<const KeyBox> boxes) {
   return bounds;
 }
 
+void narrowKeys(std::span<const KeyBox> cell, unsigned width, std::span<KeyBox> out) {
+  if (width < 1 || width > 32) throw std::invalid_argument(fmt::format("narrowKeys: width {} outside 1..32", width));
+  if (out.size() != cell.size())
+    throw std::invalid_argument(fmt::format("narrowKeys: {} boxes in, room for {}", cell.size(), out.size()));
+  if (cell.empty()) return;
+  // Bounds over mins and maxes alike: every key lies inside them, even a box
+  // given with min > max (a KeyBox caller's own), so the map stays monotone.
+  std::array<std::uint32_t, 3> lo{~0u, ~0u, ~0u}, hi{0, 0, 0};
+  for (const KeyBox& b : cell)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min({lo[a], b.min[a], b.max[a]});
+      hi[a] = std::max({hi[a], b.min[a], b.max[a]});
+    }
+  std::array<unsigned, 3> shift{};
+  for (int a = 0; a < 3; ++a) {
+    const std::uint32_t range = hi[a] - lo[a];
+    shift[a] = static_cast<unsigned>(std::max(0, static_cast<int>(std::bit_width(range)) - static_cast<int>(width)));
+  }
+  for (std::size_t i = 0; i < cell.size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      out[i].min[a] = (cell[i].min[a] - lo[a]) >> shift[a];
+      out[i].max[a] = (cell[i].max[a] - lo[a]) >> shift[a];
+    }
+}
+
 }  // namespace bpaccel

@@ -40,6 +40,17 @@ void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds& bo
 /// The bounds of boxes already converted.
 KeyBounds boundsOf(std::span<const KeyBox> boxes);
 
+/// Conservative narrowing of one device cell's keys to `width` bits (1 .. 32),
+/// for a device that compares narrower keys (BPACCEL_KEY_WIDTH < 32): on each
+/// axis, a key becomes its distance from the cell's lowest key, shifted right
+/// by the fewest bits that make the cell's range fit. That map is monotone
+/// and mins and maxes share it, so a min <= max compare holds after it
+/// wherever it held before: boxes that overlap still do. The device then
+/// reports a superset of the cell's pairs, which the host cuts back with the
+/// full keys (BroadPhase). A cell whose range fits in `width` bits narrows
+/// exactly. Writes out[i] for box i of `cell` (the same size).
+void narrowKeys(std::span<const KeyBox> cell, unsigned width, std::span<KeyBox> out);
+
 /// Throws InputError when `count` objects cannot be indexed.
 void checkObjectCount(std::uint64_t count);
 

@@ -50,7 +50,8 @@ void addCounters(const VBroadPhaseAccel& top, RunStats& stats) {
 
 }  // namespace
 
-static_assert(BPACCEL_KEY_WIDTH == 32, "the host maps float32 to 32-bit keys");
+static_assert(BPACCEL_KEY_WIDTH >= 1 && BPACCEL_KEY_WIDTH <= 32,
+              "the host's keys are 32 bits; narrower devices get narrowed keys (narrowKeys)");
 
 RtlBackend::RtlBackend(std::function<bool(std::uint64_t)> consumerReady)
     : context_(std::make_unique<VerilatedContext>()),
@@ -84,13 +85,16 @@ std::size_t RtlBackend::batchCells() { return BPACCEL_BATCH_CELLS; }
 std::uint64_t RtlBackend::runOverheadCycles() { return BPACCEL_RUN_OVERHEAD_CYCLES; }
 std::string RtlBackend::architecture() { return BPACCEL_ARCH; }
 bool RtlBackend::bipartite() const { return BPACCEL_BIPARTITE_RUNS != 0; }
+unsigned RtlBackend::keyWidth() const { return BPACCEL_KEY_WIDTH; }
 
-ModelBackend modelOfBuiltHardware() {
+ModelBackend modelOfBuiltHardware(std::optional<unsigned> keyWidth) {
   return ModelBackend(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES, BPACCEL_READ_LATENCY,
-                      BPACCEL_BATCH_CELLS, BPACCEL_BATCH_OVERLAPS_LOADS != 0);
+                      BPACCEL_BATCH_CELLS, BPACCEL_BATCH_OVERLAPS_LOADS != 0, keyWidth.value_or(BPACCEL_KEY_WIDTH));
 }
 
 std::size_t resultBeatBytesOfBuiltHardware() { return (2 * BPACCEL_INDEX_WIDTH + BPACCEL_M + 7) / 8; }
+
+std::size_t loadBoxBytesOfBuiltHardware() { return (6 * BPACCEL_KEY_WIDTH + 7) / 8; }
 
 void RtlBackend::settle() {
   top_->clock = 0;
@@ -131,6 +135,7 @@ void RtlBackend::runGuarded(std::span<const KeyBox> boxes, std::size_t split, st
   const std::size_t n = boxes.size();
   if (n > capacity())
     throw std::length_error(fmt::format("rtl: {} boxes exceed the hardware capacity {}", n, capacity()));
+  checkKeyWidth(boxes);  // the ports would keep the low bits only
   const std::size_t before = out.size();
   try {
     runOnHardware(boxes, split, out, stats);
@@ -205,6 +210,13 @@ void RtlBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std::s
       throw std::length_error(
           fmt::format("rtl: cell {} has {} boxes, above the hardware capacity {}", k, cells[k].size(), capacity()));
   checkSplits(cells, splits);
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    try {
+      checkKeyWidth(cells[k]);  // the ports would keep the low bits only
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(fmt::format("{} (cell {} of the batch)", e.what(), k));
+    }
+  }
   const std::size_t pairsBefore = out.size();
   const std::size_t endsBefore = cellEnds.size();
   RunStats added;

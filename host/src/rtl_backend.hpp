@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 
 #include "backend.hpp"
 
@@ -39,6 +40,7 @@ class RtlBackend final : public Backend {
                 std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) override;
   /// BPACCEL_BIPARTITE_RUNS: the stream architecture's hardware.
   bool bipartite() const override;
+  unsigned keyWidth() const override;
   /// One start with the split; the same reset on failure as run().
   void runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
                     RunStats& stats) override;
@@ -63,9 +65,13 @@ class RtlBackend final : public Backend {
   std::function<bool(std::uint64_t)> consumerReady_;
 };
 
-/// The C++ model of exactly the hardware this host was built with.
-ModelBackend modelOfBuiltHardware();
+/// The C++ model of exactly the hardware this host was built with; with
+/// `keyWidth`, of the same hardware at that key width (what narrower keys
+/// would cost the host, without building it: frame_timing).
+ModelBackend modelOfBuiltHardware(std::optional<unsigned> keyWidth = std::nullopt);
 /// Bytes of one result beat of that hardware ({iBase, jBase, mask[m]}), for the link model.
 std::size_t resultBeatBytesOfBuiltHardware();
+/// Bytes of one box on that hardware's load port (six keys of BPACCEL_KEY_WIDTH bits), for the link model.
+std::size_t loadBoxBytesOfBuiltHardware();
 
 }  // namespace bpaccel

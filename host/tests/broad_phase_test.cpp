@@ -1,10 +1,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <optional>
 #include <random>
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <set>
 #include <stdexcept>
 
@@ -787,4 +789,55 @@ TEST(BroadPhase, AsynchronousHandOversPassADeviceFailureOnAndRecover) {
     bp.findPairs(boxes, pairs);  // the device answers again: the next frame is whole
     EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << "failing hand-over " << failAt;
   }
+}
+
+// A device that compares narrower keys than the host's gets each cell's keys
+// narrowed (narrowKeys) and reports a superset of its pairs; the broad phase
+// keeps only those whose full keys overlap. With fewer bits the device
+// reports more: the check, not the device, makes it exact.
+TEST(BroadPhase, NarrowKeyDevicesGiveExactlyTheFullKeyPairs) {
+  const std::size_t m = 3, capacity = 24;
+  std::map<unsigned, std::uint64_t> hits;  // device-reported pairs per key width, over every case
+  for (const unsigned width : {1u, 4u, 16u, 32u}) {
+    for (const bool stream : {true, false}) {  // the stream's model (bipartite chunk pairs) and the seed's
+      const auto make = [&] { return std::make_unique<ModelBackend>(m, capacity, 3, stream ? 4 : 0, 8, stream, width); };
+      for (std::size_t n : {2u, 150u, 400u})
+        for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n)))
+          for (const auto partition : {PartitionKind::KdTree, PartitionKind::UniformGrid})
+            for (const auto& cell : {std::optional<std::size_t>{}, std::optional<std::size_t>{4},
+                                     std::optional<std::size_t>{16}})
+              for (const std::size_t perBatch : {1u, 8u}) {
+                const auto handOvers = perBatch > 1 ? HandOvers::Asynchronous : HandOvers::Synchronous;
+                BroadPhase bp(make, cell, 1, perBatch, partition, handOvers);
+                std::vector<Pair> pairs;
+                bp.findPairs(boxes, pairs);
+                const std::string label = name + " n=" + std::to_string(n) + " width " + std::to_string(width) +
+                                          " cell " + (cell ? std::to_string(*cell) : "none") + " per batch " +
+                                          std::to_string(perBatch) + (stream ? " stream" : " seed");
+                ASSERT_EQ(sorted(pairs), bruteForce(boxes)) << label;
+                hits[width] += bp.stats().hits;
+              }
+    }
+  }
+  // Coarser keys, more candidates for the check to remove.
+  EXPECT_GT(hits[1], hits[4]);
+  EXPECT_GT(hits[4], hits[16]);
+  EXPECT_GE(hits[16], hits[32]);
+}
+
+TEST(ModelBackend, RefusesKeysWiderThanItsDeviceNamingTheBox) {
+  ModelBackend narrow(2, 8, 3, 4, 8, true, 16);
+  std::vector<KeyBox> boxes(3, KeyBox{{1, 2, 3}, {4, 5, 6}});
+  boxes[2].max[1] = 0x10000;
+  std::vector<Pair> out;
+  RunStats stats;
+  try {
+    narrow.run(boxes, out, stats);
+    FAIL() << "a 17-bit key went to a 16-bit device";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("box 2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("axis 1"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(ModelBackend(2, 8, 3, 4, 8, true, 0), std::invalid_argument);
+  EXPECT_THROW(ModelBackend(2, 8, 3, 4, 8, true, 33), std::invalid_argument);
 }

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <bit>
 #include <limits>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -171,4 +173,100 @@ TEST(ToKeys, FindsTheLowestMinAndHighestMaxOfEveryAxisWhileConverting) {
       EXPECT_EQ(again.hi, expected.hi) << n << " boxes";
     }
   }
+}
+
+namespace {
+
+// The first pair (i < j) that overlaps in `full` but not in `narrow`, or none.
+std::optional<std::pair<std::size_t, std::size_t>> missedPair(const std::vector<KeyBox>& full,
+                                                              const std::vector<KeyBox>& narrow) {
+  for (std::size_t i = 0; i < full.size(); ++i)
+    for (std::size_t j = i + 1; j < full.size(); ++j)
+      if (overlaps(full[i], full[j]) && !overlaps(narrow[i], narrow[j])) return std::pair{i, j};
+  return std::nullopt;
+}
+
+// Cells whose keys come from one of several spreads: a few ulps apart, about
+// a float's worth of world units, the whole key space, and the extremes.
+std::vector<KeyBox> randomCell(std::mt19937& rng, std::size_t n) {
+  const std::uint32_t spreads[] = {3, 1u << 12, 1u << 20, 1u << 28, ~0u};
+  const std::uint32_t spread = spreads[rng() % std::size(spreads)];
+  const std::uint32_t base = spread == ~0u ? 0 : static_cast<std::uint32_t>(rng() % (~0u - 2 * spread));
+  std::uniform_int_distribution<std::uint32_t> offset(0, spread), size(0, std::max<std::uint32_t>(spread / 8, 1));
+  std::vector<KeyBox> cell(n);
+  for (KeyBox& b : cell)
+    for (int a = 0; a < 3; ++a) {
+      b.min[a] = base + offset(rng);
+      if (spread == ~0u && rng() % 4 == 0) b.min[a] = rng() % 2 ? 0u : ~0u;  // the extreme keys
+      b.max[a] = static_cast<std::uint32_t>(std::min<std::uint64_t>(std::uint64_t{b.min[a]} + size(rng), ~0u));
+    }
+  return cell;
+}
+
+}  // namespace
+
+// The device may compare fewer bits than the host's keys; narrowing may add
+// pairs (the host removes them) but never lose one, and every key fits.
+TEST(NarrowKeys, KeepsEveryOverlapAndFitsTheWidth) {
+  std::mt19937 rng(11);
+  for (const unsigned width : {1u, 2u, 4u, 8u, 16u, 24u, 31u, 32u}) {
+    for (int trial = 0; trial < 200; ++trial) {
+      const std::vector<KeyBox> cell = randomCell(rng, 1 + rng() % 40);
+      std::vector<KeyBox> narrow(cell.size());
+      narrowKeys(cell, width, narrow);
+      const std::uint64_t top = (std::uint64_t{1} << width) - 1;
+      for (const KeyBox& b : narrow)
+        for (int a = 0; a < 3; ++a) {
+          ASSERT_LE(b.min[a], top) << "width " << width;
+          ASSERT_LE(b.max[a], top) << "width " << width;
+        }
+      const auto missed = missedPair(cell, narrow);
+      ASSERT_FALSE(missed) << "width " << width << ": boxes " << missed->first << " and " << missed->second;
+    }
+  }
+}
+
+// Where the cell's keys lie within 2^width of each other nothing is rounded:
+// the narrow keys overlap exactly where the full ones do.
+TEST(NarrowKeys, IsExactWhereTheCellsRangeFits) {
+  std::mt19937 rng(12);
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<KeyBox> cell(2 + rng() % 30);
+    const std::uint32_t base = rng();
+    for (KeyBox& b : cell)
+      for (int a = 0; a < 3; ++a) {
+        b.min[a] = base / 2 + static_cast<std::uint32_t>(rng() % 40000);
+        b.max[a] = b.min[a] + static_cast<std::uint32_t>(rng() % 20000);
+      }
+    std::vector<KeyBox> narrow(cell.size());
+    narrowKeys(cell, 16, narrow);
+    for (std::size_t i = 0; i < cell.size(); ++i)
+      for (std::size_t j = i + 1; j < cell.size(); ++j)
+        ASSERT_EQ(overlaps(cell[i], cell[j]), overlaps(narrow[i], narrow[j])) << "boxes " << i << ", " << j;
+  }
+}
+
+// The property above can fail: a device port narrower than the keys keeps
+// their low bits, which is not monotone, and loses pairs.
+TEST(NarrowKeys, TheCheckCatchesKeysCutToTheirLowBits) {
+  std::mt19937 rng(13);
+  bool caught = false;
+  for (int trial = 0; trial < 50 && !caught; ++trial) {
+    const std::vector<KeyBox> cell = randomCell(rng, 30);
+    std::vector<KeyBox> cut = cell;
+    for (KeyBox& b : cut)
+      for (int a = 0; a < 3; ++a) {
+        b.min[a] &= 0xFFFF;
+        b.max[a] &= 0xFFFF;
+      }
+    caught = missedPair(cell, cut).has_value();
+  }
+  EXPECT_TRUE(caught);
+}
+
+TEST(NarrowKeys, RejectsAWidthOutsideOneToThirtyTwo) {
+  const std::vector<KeyBox> cell(2);
+  std::vector<KeyBox> out(2);
+  EXPECT_THROW(narrowKeys(cell, 0, out), std::invalid_argument);
+  EXPECT_THROW(narrowKeys(cell, 33, out), std::invalid_argument);
 }

@@ -65,6 +65,7 @@ int main(int argc, char** argv) {
   std::size_t objects = 8000, cellSize = 128, cellsPerBatch = 16, frames = 30, passes = 10;
   std::string partition = "grid", backendName = "model";
   std::vector<std::size_t> firstBatchCells;
+  std::vector<unsigned> keyWidths;
   double clockMHz = 100;
   bool evict = false;
   app.add_option("--objects", objects)->capture_default_str()->check(CLI::PositiveNumber);
@@ -82,6 +83,10 @@ int main(int argc, char** argv) {
   app.add_option("--passes", passes, "Passes over the recorded frames")->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_flag("--evict", evict, "Evict the caches before each frame");
+  app.add_option("--key-width", keyWidths,
+                 "Key widths of the model's device (default: the built hardware's); several: compared. "
+                 "Below 32 the host narrows each cell's keys and checks the pairs")
+      ->check(CLI::Range(1u, 32u));
   CLI11_PARSE(app, argc, argv);
 
   bpaccel::SceneConfig sc;
@@ -97,11 +102,18 @@ int main(int argc, char** argv) {
   for (std::size_t f = 0; f < frames; ++f) bpaccel::exactPairs(recorded[f], exact[f]);
 
   if (firstBatchCells.empty()) firstBatchCells.push_back(cellsPerBatch);
-  const auto makeBackend = [&]() -> std::unique_ptr<bpaccel::Backend> {
+  const unsigned builtKeyWidth = bpaccel::modelOfBuiltHardware().keyWidth();
+  if (keyWidths.empty()) keyWidths.push_back(builtKeyWidth);
+  if (backendName != "model" && (keyWidths.size() > 1 || keyWidths.front() != builtKeyWidth)) {
+    fmt::print(stderr, "frame_timing: --key-width other than the built hardware's ({}) needs --backend model\n",
+               builtKeyWidth);
+    return 2;
+  }
+  const auto makeBackend = [&](unsigned keyWidth) -> std::unique_ptr<bpaccel::Backend> {
     if (backendName == "rtl") return std::make_unique<bpaccel::RtlBackend>();
     if (backendName == "cpu")  // software all-pairs: the host's own parts stand out in a profile
       return std::make_unique<bpaccel::CpuBackend>();
-    return std::make_unique<bpaccel::ModelBackend>(bpaccel::modelOfBuiltHardware());
+    return std::make_unique<bpaccel::ModelBackend>(bpaccel::modelOfBuiltHardware(keyWidth));
   };
   // One configuration: its backend, its broad phase and its figures.
   struct Timed {
@@ -109,16 +121,19 @@ int main(int argc, char** argv) {
     std::unique_ptr<bpaccel::BroadPhase> phase;
     std::vector<double> host, convert, part, cells, decode, pipelined;
     std::vector<double> allocations;  // after the first pass
+    unsigned keyWidth = 32;
   };
   std::vector<Timed> timed;
-  for (const std::size_t first : firstBatchCells) {
-    Timed t;
-    t.backend = makeBackend();
-    t.phase = std::make_unique<bpaccel::BroadPhase>(*t.backend, cellSize, cellsPerBatch,
-                                                    bpaccel::parsePartitionKind(partition));
-    t.phase->setFirstBatchCells(first);
-    timed.push_back(std::move(t));
-  }
+  for (const std::size_t first : firstBatchCells)
+    for (const unsigned keyWidth : keyWidths) {
+      Timed t;
+      t.keyWidth = keyWidth;
+      t.backend = makeBackend(keyWidth);
+      t.phase = std::make_unique<bpaccel::BroadPhase>(*t.backend, cellSize, cellsPerBatch,
+                                                      bpaccel::parsePartitionKind(partition));
+      t.phase->setFirstBatchCells(first);
+      timed.push_back(std::move(t));
+    }
   bpaccel::PipelineModel model;  // the benchmark's link model (--link-gbytes-per-s 4, --link-latency-us 1)
   model.clockHz = clockMHz * 1e6;
   model.bytesPerBeat = static_cast<double>(bpaccel::resultBeatBytesOfBuiltHardware());
@@ -146,6 +161,7 @@ int main(int argc, char** argv) {
         double decoded = 0;
         for (const auto& r : t.phase->runs()) decoded += r.decodeSeconds;
         t.decode.push_back(decoded);
+        model.bytesPerBox = (6.0 * t.keyWidth) / 8;  // the link carries the device's keys
         t.pipelined.push_back(bpaccel::modelPipeline(t.phase->runs(), hostSeconds, model).frameSeconds);
         std::sort(pairs.begin(), pairs.end());
         if (pairs != exact[f]) {
@@ -163,17 +179,17 @@ int main(int argc, char** argv) {
   for (std::size_t k = 0; k < timed.size(); ++k) {
     const Timed& t = timed[k];
     const auto& stats = t.phase->stats();
-    fmt::print("first_batch_cells {} host_us {:.1f} convert_us {:.1f} partition_us {:.1f} cells_host_us {:.1f} "
+    fmt::print("key_width {} first_batch_cells {} host_us {:.1f} convert_us {:.1f} partition_us {:.1f} cells_host_us {:.1f} "
                "(decode_us {:.1f}) pipelined_us_modelled {:.1f} at {} MHz; pairs {} hits {} runs {} batches {} "
                "device_cycles {} allocations/frame {}\n",
-               t.phase->firstBatchCells(), us(t.host), us(t.convert), us(t.part), us(t.cells), us(t.decode),
+               t.keyWidth, t.phase->firstBatchCells(), us(t.host), us(t.convert), us(t.part), us(t.cells), us(t.decode),
                us(t.pipelined), clockMHz, pairs.size(), stats.hits, stats.runs, stats.batches, stats.deviceCycles(),
                median(t.allocations));
     if (k > 0) {  // paired with the first configuration, frame by frame
       std::vector<double> ratio;
       for (std::size_t i = 0; i < t.pipelined.size(); ++i) ratio.push_back(t.pipelined[i] / timed[0].pipelined[i]);
-      fmt::print("  overlapped frame against first_batch_cells {}: median ratio {:.3f}\n",
-                 timed[0].phase->firstBatchCells(), median(ratio));
+      fmt::print("  overlapped frame against key_width {} first_batch_cells {}: median ratio {:.3f}\n",
+                 timed[0].keyWidth, timed[0].phase->firstBatchCells(), median(ratio));
     }
   }
   return 0;
