@@ -469,13 +469,13 @@ void BroadPhase::Worker::flush() {
     filling.cellItems.push_back(c.copied ? std::span<const std::uint32_t>(filling.items).subspan(c.begin, c.count)
                                          : c.items);
   }
+  // Narrowed here, before the hand-over's clock starts: it is host work.
+  const auto toDevice = deviceCells(filling);
   if (!async) {
     local.clear();
     cellEnds.clear();
     handOver(
-        [&](RunStats& runStats) {
-          backend->runBatch(deviceCells(filling), filling.splits, local, cellEnds, runStats);
-        },
+        [&](RunStats& runStats) { backend->runBatch(toDevice, filling.splits, local, cellEnds, runStats); },
         [&] { decodeBatch(filling, local, cellEnds); });
     filling.clear();
     return;
@@ -486,7 +486,7 @@ void BroadPhase::Worker::flush() {
   // device holds stay valid) and `filling` takes the decoded one's storage.
   RunRecord record;
   record.readySeconds = seconds(frameStart, Clock::now()) - backendSeconds;
-  std::future<BatchResult> result = async->submit(deviceCells(filling), filling.splits);
+  std::future<BatchResult> result = async->submit(toDevice, filling.splits);
   try {
     collect();
   } catch (...) {
@@ -618,7 +618,7 @@ Pair* BroadPhase::Worker::keepPairs(std::span<const Pair> pairs, std::span<const
       const std::uint32_t i = ids[a], j = ids[b];
       *to = {std::min(i, j), std::max(i, j)};
       if constexpr (kCheckOverlap)
-        to += static_cast<int>(ownsPair(bits[a], bits[b])) & static_cast<int>(overlaps(packed[a], packed[b]));
+        to += static_cast<int>(ownsPair(bits[a], bits[b])) & static_cast<int>(overlapsBranchFree(packed[a], packed[b]));
       else
         to += ownsPair(bits[a], bits[b]);
     }
@@ -631,7 +631,7 @@ Pair* BroadPhase::Worker::keepPairs(std::span<const Pair> pairs, std::span<const
     const std::uint32_t i = ids[a], j = ids[b];
     *to = {std::min(i, j), std::max(i, j)};
     int kept = static_cast<int>((keep & kind) != 0) & static_cast<int>(owned);
-    if constexpr (kCheckOverlap) kept &= static_cast<int>(overlaps(packed[a], packed[b]));
+    if constexpr (kCheckOverlap) kept &= static_cast<int>(overlapsBranchFree(packed[a], packed[b]));
     to += kept;
   }
   return to;

@@ -42,14 +42,20 @@ KeyBounds boundsOf(std::span<const KeyBox> boxes);
 
 /// Conservative narrowing of one device cell's keys to `width` bits (1 .. 32),
 /// for a device that compares narrower keys (BPACCEL_KEY_WIDTH < 32): on each
-/// axis, a key becomes its distance from the cell's lowest key, shifted right
-/// by the fewest bits that make the cell's range fit. That map is monotone
+/// axis, a key becomes its distance from the cell's lowest min, shifted right
+/// by the fewest bits that make the cell's range (up to its highest max) fit. That map is monotone
 /// and mins and maxes share it, so a min <= max compare holds after it
 /// wherever it held before: boxes that overlap still do. The device then
 /// reports a superset of the cell's pairs, which the host cuts back with the
 /// full keys (BroadPhase). A cell whose range fits in `width` bits narrows
 /// exactly. Writes out[i] for box i of `cell` (the same size).
 void narrowKeys(std::span<const KeyBox> cell, unsigned width, std::span<KeyBox> out);
+
+namespace detail {
+/// narrowKeys without its checks and without SIMD (what CPUs without AVX2
+/// run; the tests compare the two).
+void narrowKeysScalar(std::span<const KeyBox> cell, unsigned width, std::span<KeyBox> out);
+}  // namespace detail
 
 /// Throws InputError when `count` objects cannot be indexed.
 void checkObjectCount(std::uint64_t count);

@@ -33,6 +33,13 @@ inline bool overlaps(const KeyBox& a, const KeyBox& b) {
          a.min[2] <= b.max[2] && b.min[2] <= a.max[2];
 }
 
+/// The same without a branch: for loops over pairs whose outcome is hard to predict.
+inline bool overlapsBranchFree(const KeyBox& a, const KeyBox& b) {
+  return static_cast<bool>((static_cast<unsigned>(a.min[0] <= b.max[0]) & static_cast<unsigned>(b.min[0] <= a.max[0])) &
+                           (static_cast<unsigned>(a.min[1] <= b.max[1]) & static_cast<unsigned>(b.min[1] <= a.max[1])) &
+                           (static_cast<unsigned>(a.min[2] <= b.max[2]) & static_cast<unsigned>(b.min[2] <= a.max[2])));
+}
+
 /// An overlapping pair of object indices, first < second.
 using Pair = std::pair<std::uint32_t, std::uint32_t>;
 
