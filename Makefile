@@ -159,7 +159,7 @@ fpga: deps
 	$(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/$(FPGA_NAME) --m $(M) --out results/fpga/$(FPGA_NAME).json $(FPGA_ARGS)
 
 fpga-sweep: deps
-	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --memory-style $(FPGA_MEMORY_STYLE) --verilog-root build/fpga-verilog --emit always --budget-min 60
+	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --key-width $(KEY_WIDTH) --memory-style $(FPGA_MEMORY_STYLE) --verilog-root build/fpga-verilog --emit always --budget-min 60
 
 $(FPGA_TEST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
 	$(SBT) "runMain bpaccel.EmitVerilog --m 2 --target-dir $(FPGA_TEST_VERILOG)"

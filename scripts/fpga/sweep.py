@@ -31,10 +31,25 @@ def prefix(arch: str) -> str:
     return "" if arch == "seed" else f"{arch}-"
 
 
-def markers(arch: str) -> tuple[str, str]:
-    if arch == "seed":
+def key_suffix(key_width: int) -> str:
+    """File-name suffix of a key width other than 32 (as make's KEY_SUFFIX)."""
+    return "" if key_width == 32 else f"-k{key_width}"
+
+
+def report_name(arch: str, m: int, key_width: int) -> str:
+    """Name of one m's report and Verilog folder (make fpga's FPGA_NAME)."""
+    return f"{prefix(arch)}m{m}{key_suffix(key_width)}"
+
+
+def sweep_name(arch: str, key_width: int) -> str:
+    return f"{prefix(arch)}sweep{key_suffix(key_width)}.json"
+
+
+def markers(arch: str, key_width: int = 32) -> tuple[str, str]:
+    if arch == "seed" and key_width == 32:
         return BEGIN, END
-    return BEGIN.replace("sweep table", f"sweep table {arch}"), END.replace("sweep table", f"sweep table {arch}")
+    series = f"{arch}{key_suffix(key_width)}"
+    return BEGIN.replace("sweep table", f"sweep table {series}"), END.replace("sweep table", f"sweep table {series}")
 
 
 def log(msg: str) -> None:
@@ -45,6 +60,9 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--arch", choices=["seed", "stream"], default="stream",
                     help="architecture; its reports are <prefix>m<M>.json (prefix '' for seed, 'stream-')")
+    ap.add_argument("--key-width", type=int, default=32,
+                    help="bits of each coordinate key (make verilog KEY_WIDTH=...); other than 32, the reports "
+                         "and the doc's table get -k<width> (the host narrows keys for such a device, docs/host.md)")
     ap.add_argument("--capacity", type=int, default=None,
                     help="objects per run (default: make's, 256*m for seed, 2048 for stream)")
     ap.add_argument("--verilog-root", type=Path, default=REPO / "build" / "fpga-verilog",
@@ -91,7 +109,7 @@ def main() -> int:
     last_time = None
     stop_reason = None
     for i, m in enumerate(ms):
-        out = args.results / f"{prefix(args.arch)}m{m}.json"
+        out = args.results / f"{report_name(args.arch, m, args.key_width)}.json"
         entry = {"m": m, "report": str(out.relative_to(REPO)) if out.is_relative_to(REPO) else str(out)}
         if stop_reason:
             entry.update({"status": "not_run", "reason": stop_reason})
@@ -120,7 +138,7 @@ def main() -> int:
             entry.update({"status": "not_run", "reason": stop_reason})
             runs.append(entry)
             continue
-        vdir = args.verilog_root / f"{prefix(args.arch)}m{m}"
+        vdir = args.verilog_root / report_name(args.arch, m, args.key_width)
         if args.emit == "always" or not (vdir / "filelist.f").is_file():
             if args.emit == "never":
                 entry.update({"status": "not_run", "reason": f"no Verilog in {vdir} (--emit never)"})
@@ -128,6 +146,7 @@ def main() -> int:
                 continue
             log(f"emitting Verilog for m={m} into {vdir}")
             r = subprocess.run(["make", "-C", str(REPO), "verilog", f"ARCH={args.arch}", f"M={m}",
+                                f"KEY_WIDTH={args.key_width}",
                                 f"VERILOG_DIR={vdir.resolve()}", f"MEMORY_STYLE={args.memory_style}",
                                 *([f"CAPACITY={args.capacity}"] if args.capacity else [])])
             if r.returncode != 0:
@@ -160,28 +179,29 @@ def main() -> int:
     sweep = {
         "schema": "bpaccel-fpga-sweep-1",
         "arch": args.arch,
+        "key_width": args.key_width,
         "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "wall_s": round(time.monotonic() - t0, 1),
         "budget_min": args.budget_min,
         "runs": runs,
     }
     args.results.mkdir(parents=True, exist_ok=True)
-    (args.results / f"{prefix(args.arch)}sweep.json").write_text(json.dumps(sweep, indent=2) + "\n")
-    log(f"wrote {args.results / (prefix(args.arch) + 'sweep.json')}")
+    (args.results / sweep_name(args.arch, args.key_width)).write_text(json.dumps(sweep, indent=2) + "\n")
+    log(f"wrote {args.results / sweep_name(args.arch, args.key_width)}")
     table = render(sweep)
     print(table)
-    update_doc(args.doc, table, args.arch)
+    update_doc(args.doc, table, args.arch, args.key_width)
     return 0 if all(r.get("status") in ("ok", "does_not_fit", "not_run") for r in runs) else 1
 
 
 def table_only(args) -> int:
-    path = args.results / f"{prefix(args.arch)}sweep.json"
+    path = args.results / sweep_name(args.arch, args.key_width)
     if not path.is_file():
         log(f"{path} not found: run a sweep first")
         return 2
     sweep = json.loads(path.read_text())
     for e in sweep["runs"]:
-        report = args.results / f"{prefix(args.arch)}m{e['m']}.json"
+        report = args.results / f"{report_name(args.arch, e['m'], args.key_width)}.json"
         # A report run by hand (make fpga M=<m>) since the sweep replaces its "not run" entry.
         if e.get("status") in ("ok", "does_not_fit") or report.is_file():
             e.pop("reason", None)
@@ -191,7 +211,7 @@ def table_only(args) -> int:
     path.write_text(json.dumps(sweep, indent=2) + "\n")
     table = render(sweep)
     print(table)
-    update_doc(args.doc, table, args.arch)
+    update_doc(args.doc, table, args.arch, args.key_width)
     return 0
 
 
@@ -237,14 +257,16 @@ def render(sweep: dict) -> str:
             rows.append(f"| {m} | | | {st.replace('_', ' ')} (below) | | | | | | | | |")
             notes.append(f"* m = {m}: {e.get('reason', '')}")
     arch = sweep.get("arch", "seed")
-    begin, end = markers(arch)
+    key_width = sweep.get("key_width", 32)
+    begin, end = markers(arch, key_width)
     text_bd = render_breakdown(sweep) if arch == "seed" else []
     text_cp = render_paths(sweep)
     text = [begin, "",
             f"Sweep of {sweep['date']}; flow wall time summed over m: "
             f"{sum(e.get('wall_s') or 0 for e in sweep['runs']) / 60:.0f} min "
             f"(budget {sweep['budget_min']:g} min; reused reports count with their own run time); "
-            f"per-m reports in `results/fpga/{prefix(arch)}m<m>.json`.", "",
+            f"per-m reports in `results/fpga/{prefix(arch)}m<m>{key_suffix(key_width)}.json`"
+            f"{f'; {key_width}-bit keys' if key_width != 32 else ''}.", "",
             *rows, ""]
     if notes:
         text += ["Not run or not finished:", "", *notes, ""]
@@ -303,8 +325,8 @@ def short(cell: str, n: int = 48) -> str:
     return cell if len(cell) <= n else cell[:n] + "…"
 
 
-def update_doc(doc: Path, table: str, arch: str) -> None:
-    begin, end = markers(arch)
+def update_doc(doc: Path, table: str, arch: str, key_width: int = 32) -> None:
+    begin, end = markers(arch, key_width)
     if not doc.is_file():
         doc.parent.mkdir(parents=True, exist_ok=True)
         doc.write_text(f"# FPGA results\n\n{table}\n")
