@@ -488,13 +488,17 @@ std::string Benchmark::table(const nlohmann::json& results) {
         first < perBatch ? fmt::format("hand-over; a frame's first holds {} cells, each next twice as many up to {}",
                                        first, perBatch)
                          : fmt::format("hand-over of up to {} cells", perBatch);
+    // A device of narrower keys gets them narrowed per cell, its pairs checked on the host (docs/host.md).
+    const auto keyWidth = cfg.contains("hardware") ? cfg["hardware"].value("key_width", 32) : 32;
+    const std::string keys = keyWidth == 32 ? "" : fmt::format(", {}-bit keys narrowed per cell", keyWidth);
     legend = fmt::format(
-        "accelerator = measured host + modelled device ({:.1f} MHz, device cycles with loads, {} backend) + modelled "
-        "transfer ({:.1f} GB/s, {:.1f} us per {}; boxes stream through the "
-        "24-byte-a-cycle load port, so only the link's excess over one cycle a box counts)",
-        cfg["clock_hz"].get<double>() / 1e6, cfg["accelerator_backend"].get<std::string>(),
+        "accelerator = measured host + modelled device ({:.1f} MHz, device cycles with loads, {} backend{}) + "
+        "modelled transfer ({:.1f} GB/s, {:.1f} us per {}; boxes stream through the "
+        "{:g}-byte-a-cycle load port, so only the link's excess over one cycle a box counts)",
+        cfg["clock_hz"].get<double>() / 1e6, cfg["accelerator_backend"].get<std::string>(), keys,
         cfg["link_model"]["bandwidth_bytes_per_second"].get<double>() / 1e9,
-        cfg["link_model"]["latency_seconds_per_run"].get<double>() * 1e6, handOvers);
+        cfg["link_model"]["latency_seconds_per_run"].get<double>() * 1e6, handOvers,
+        cfg["link_model"].value("bytes_per_box", 24.0));
   }
   header("Median broad-phase time per frame, ms, one thread unless named (" + legend +
          "; ! = missed exact pairs; - = skipped, see below)");
