@@ -121,7 +121,7 @@ std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, do
     device->clockHz = clockMHz * 1e6;
     device->clockSource = fmt::format("--clock-mhz {}", clockMHz);
   } else {
-    auto clock = bpaccel::clockFromFpgaReport(fpgaReport, BPACCEL_M, BPACCEL_ARCH);
+    auto clock = bpaccel::clockFromFpgaReport(fpgaReport, BPACCEL_M, BPACCEL_ARCH, BPACCEL_KEY_WIDTH);
     device->clockHz = clock.hz;
     device->clockSource = std::move(clock.source);
   }
@@ -230,9 +230,7 @@ int main(int argc, char** argv) {
   // (first hand-overs of 1 to 16 cells did about as well), for about 90 and
   // 240 more load cycles.
   std::size_t firstBatchCells = 4;
-  // The FPGA flow's report names: m<m>.json for the seed architecture, <arch>-m<m>.json otherwise.
-  std::string fpgaReport = BPACCEL_ARCH_STREAM ? fmt::format("results/fpga/stream-m{}.json", BPACCEL_M)
-                                               : fmt::format("results/fpga/m{}.json", BPACCEL_M);
+  std::string fpgaReport = bpaccel::fpgaReportPath(BPACCEL_M, BPACCEL_ARCH, BPACCEL_KEY_WIDTH);
   auto* benchCmd = app.add_subcommand(
       "bench", "Bouncing-cube benchmark: Bullet's, FCL's, CGAL's and ODE's broad phases against the accelerator");
   auto addSceneOptions = [](CLI::App* cmd, bpaccel::SceneConfig& sc) {

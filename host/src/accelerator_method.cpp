@@ -97,7 +97,12 @@ std::vector<MethodSpec> cpuMethods(const std::vector<std::optional<std::size_t>>
                      [partition](std::optional<std::size_t> c) { return std::make_unique<CpuMethod>(c, 1, partition); });
 }
 
-DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std::string& arch) {
+std::string fpgaReportPath(int m, const std::string& arch, int keyWidth) {
+  return fmt::format("results/fpga/{}m{}{}.json", arch == "seed" ? "" : arch + "-", m,
+                     keyWidth == 32 ? "" : fmt::format("-k{}", keyWidth));
+}
+
+DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std::string& arch, int keyWidth) {
   const auto fallback = [](std::string why) { return DeviceClock{100e6, "default 100 MHz (" + std::move(why) + ")"}; };
   std::ifstream in(fpgaReport);
   if (!in) return fallback("no FPGA report at " + fpgaReport);
@@ -109,6 +114,8 @@ DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std:
       return fallback(fmt::format("{} is for m = {}, not {}", fpgaReport, reportM, m));
     if (const auto reportArch = j.value("arch", std::string("seed")); reportArch != arch)
       return fallback(fmt::format("{} is for arch = {}, not {}", fpgaReport, reportArch, arch));
+    if (const int reportKeys = j.value("key_width", 32); reportKeys != keyWidth)
+      return fallback(fmt::format("{} is for {}-bit keys, not {}", fpgaReport, reportKeys, keyWidth));
     const double mhz = j.at("ecp5").at("fmax_mhz").get<double>();
     if (mhz > 0) return {mhz * 1e6, fmt::format("Fmax {:.2f} MHz measured by nextpnr on ECP5 ({})", mhz, fpgaReport)};
     return fallback(fpgaReport + " has no positive Fmax");

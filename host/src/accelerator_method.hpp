@@ -36,12 +36,17 @@ struct DeviceClock {
   std::string source = "default 100 MHz";
 };
 
-/// The default clock of a device with m lanes of architecture `arch`: the Fmax
-/// that the FPGA flow's report at `fpgaReport` measured, if that report is a
-/// valid result for the same m and architecture; otherwise 100 MHz, with the
-/// reason in `source`. Reports without "arch" predate the stream architecture
-/// and are the seed's.
-DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std::string& arch);
+/// The default clock of a device with m lanes of architecture `arch` and
+/// `keyWidth`-bit keys: the Fmax that the FPGA flow's report at `fpgaReport`
+/// measured, if that report is a valid result for the same m, architecture
+/// and key width; otherwise 100 MHz, with the reason in `source`. Reports
+/// without "arch" predate the stream architecture and are the seed's; those
+/// without "key_width" are of 32-bit keys.
+DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std::string& arch, int keyWidth = 32);
+
+/// Where the FPGA flow writes the report of that device (make fpga's FPGA_NAME):
+/// results/fpga/[<arch>-]m<m>[-k<width>].json, no prefix for the seed, no suffix for 32-bit keys.
+std::string fpgaReportPath(int m, const std::string& arch, int keyWidth);
 
 /// The device the accelerator methods model, given at run time by the program
 /// that links a hardware configuration (the benchmark library links none).

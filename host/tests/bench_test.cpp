@@ -479,6 +479,16 @@ TEST(DeviceClock, TheDefaultClockIsTheFmaxOfAReportOfTheSameMAndArchitectureOnly
   EXPECT_DOUBLE_EQ(otherM.hz, 100e6);
   EXPECT_NE(otherM.source.find("m = 8, not 16"), std::string::npos) << otherM.source;
 
+  // Nor a report of other key widths: a 16-bit device's Fmax is not the 32-bit one's.
+  auto narrow = seed8;
+  narrow["key_width"] = 16;
+  EXPECT_DOUBLE_EQ(clockFromFpgaReport(write("narrow.json", narrow), 8, "seed", 16).hz, 107.5e6);
+  const auto otherKeys = clockFromFpgaReport(write("narrow.json", narrow), 8, "seed");
+  EXPECT_DOUBLE_EQ(otherKeys.hz, 100e6);
+  EXPECT_NE(otherKeys.source.find("16-bit keys, not 32"), std::string::npos) << otherKeys.source;
+  EXPECT_EQ(fpgaReportPath(8, "seed", 32), "results/fpga/m8.json");
+  EXPECT_EQ(fpgaReportPath(64, "stream", 16), "results/fpga/stream-m64-k16.json");
+
   auto notFit = seed8;
   notFit["status"] = "does_not_fit";
   EXPECT_DOUBLE_EQ(clockFromFpgaReport(write("nofit.json", notFit), 8, "seed").hz, 100e6);
