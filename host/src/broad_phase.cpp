@@ -134,7 +134,8 @@ struct BroadPhase::Worker {
   // The batch's cells as the device gets them: narrowed where it needs it.
   std::span<const std::span<const KeyBox>> deviceCells(Batch& batch);
   Pair* keepOwned(std::span<const Pair> pairs, std::span<const std::uint32_t> items, std::span<const KeyBox> packed,
-             std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep, Pair* to) const {
+                  std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep,
+                  Pair* to) const {
     return narrows() ? keepPairs<true>(pairs, items, packed, below, region, splitAt, keep, to)
                      : keepPairs<false>(pairs, items, packed, below, region, splitAt, keep, to);
   }

@@ -311,7 +311,9 @@ struct NarrowMap {
           std::max(0, static_cast<int>(std::bit_width(hi[a] - lo[a])) - static_cast<int>(width)));
     }
   }
-  std::uint32_t operator()(std::uint32_t key, int a) const { return (std::clamp(key, lo[a], hi[a]) - lo[a]) >> shift[a]; }
+  std::uint32_t operator()(std::uint32_t key, int a) const {
+    return (std::clamp(key, lo[a], hi[a]) - lo[a]) >> shift[a];
+  }
 };
 
 }  // namespace

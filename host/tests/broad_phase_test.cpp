@@ -800,7 +800,9 @@ TEST(BroadPhase, NarrowKeyDevicesGiveExactlyTheFullKeyPairs) {
   std::map<unsigned, std::uint64_t> hits;  // device-reported pairs per key width, over every case
   for (const unsigned width : {1u, 4u, 16u, 32u}) {
     for (const bool stream : {true, false}) {  // the stream's model (bipartite chunk pairs) and the seed's
-      const auto make = [&] { return std::make_unique<ModelBackend>(m, capacity, 3, stream ? 4 : 0, 8, stream, width); };
+      const auto make = [&] {
+        return std::make_unique<ModelBackend>(m, capacity, 3, stream ? 4 : 0, 8, stream, width);
+      };
       for (std::size_t n : {2u, 150u, 400u})
         for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n)))
           for (const auto partition : {PartitionKind::KdTree, PartitionKind::UniformGrid})

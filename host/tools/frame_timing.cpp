@@ -179,9 +179,9 @@ int main(int argc, char** argv) {
   for (std::size_t k = 0; k < timed.size(); ++k) {
     const Timed& t = timed[k];
     const auto& stats = t.phase->stats();
-    fmt::print("key_width {} first_batch_cells {} host_us {:.1f} convert_us {:.1f} partition_us {:.1f} cells_host_us {:.1f} "
-               "(decode_us {:.1f}) pipelined_us_modelled {:.1f} at {} MHz; pairs {} hits {} runs {} batches {} "
-               "device_cycles {} allocations/frame {}\n",
+    fmt::print("key_width {} first_batch_cells {} host_us {:.1f} convert_us {:.1f} partition_us {:.1f} "
+               "cells_host_us {:.1f} (decode_us {:.1f}) pipelined_us_modelled {:.1f} at {} MHz; pairs {} hits {} "
+               "runs {} batches {} device_cycles {} allocations/frame {}\n",
                t.keyWidth, t.phase->firstBatchCells(), us(t.host), us(t.convert), us(t.part), us(t.cells), us(t.decode),
                us(t.pipelined), clockMHz, pairs.size(), stats.hits, stats.runs, stats.batches, stats.deviceCycles(),
                median(t.allocations));
