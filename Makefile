@@ -38,7 +38,8 @@ FPGA_NAME := $(ARCH_PREFIX)m$(M)$(KEY_SUFFIX)$(if $(filter $(FPGA_DEFAULT_MEMORY
 HOST_VERILOG := build/verilog/$(ARCH_PREFIX)m$(M)-c$(CAPACITY)$(KEY_SUFFIX)
 HOST_BUILD   := build/host-$(ARCH_PREFIX)m$(M)-c$(CAPACITY)$(KEY_SUFFIX)
 # Where the bpaccel CLI goes; the benchmark's configuration gets its own.
-HOST_BIN_DIR ?= build/bin
+# A device of narrower keys gets its own too (build/bin-k16).
+HOST_BIN_DIR ?= build/bin$(KEY_SUFFIX)
 SCALA_SOURCES := $(wildcard src/bpaccel/*.scala) build.sbt
 
 # Debian's interpreter, which has python3-matplotlib.
