@@ -72,6 +72,9 @@ class Backend {
   }
 };
 
+/// Bytes of one box on a device's load port: six keys of `keyWidth` bits (the link model's box).
+constexpr std::size_t loadBoxBytes(unsigned keyWidth) { return (6 * std::size_t{keyWidth} + 7) / 8; }
+
 /// The accelerator's schedule in closed form: issue cycles of one run of n
 /// objects with m lanes, sum over blocks b of (n - 1 - b*m); 0 for n < 2.
 /// A bipartite run (split = na > 0) runs the blocks b*m <= na-1 only, in

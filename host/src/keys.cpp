@@ -169,6 +169,26 @@ __attribute__((target("avx2"))) __m256i keysOfBitsAvx2(__m256i bits) {
   return _mm256_xor_si256(bits, _mm256_or_si256(_mm256_srai_epi32(bits, 31), signBit));
 }
 
+// Merges the running bounds of keys taken four boxes (three vectors) at a
+// time into `bounds`: lane l of vector v is word 8v + l of the four, axis
+// (8v + l) % 3, a min where (8v + l) % 6 < 3; `least` holds the lanes'
+// lowest keys (read in min lanes), `most` their highest (read in max lanes).
+__attribute__((target("avx2"))) void mergeLanesAvx2(const __m256i (&least)[3], const __m256i (&most)[3],
+                                                     KeyBounds& bounds) {
+  for (int v = 0; v < 3; ++v) {
+    alignas(32) std::array<std::uint32_t, 8> lo, hi;
+    _mm256_store_si256(reinterpret_cast<__m256i*>(lo.data()), least[v]);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(hi.data()), most[v]);
+    for (int lane = 0; lane < 8; ++lane) {
+      const int word = 8 * v + lane, axis = word % 3;
+      if (word % 6 < 3)
+        bounds.lo[axis] = std::min(bounds.lo[axis], lo[lane]);
+      else
+        bounds.hi[axis] = std::max(bounds.hi[axis], hi[lane]);
+    }
+  }
+}
+
 template <bool kBounds>
 __attribute__((target("avx2"))) std::size_t toKeysAvx2(std::span<const Aabb> boxes, std::vector<KeyBox>& out,
                                                         bool& bad, KeyBounds* bounds) {
@@ -215,20 +235,7 @@ __attribute__((target("avx2"))) std::size_t toKeysAvx2(std::span<const Aabb> box
     }
   }
   bad |= _mm256_movemask_epi8(flags) != 0;
-  if constexpr (kBounds) {
-    for (int v = 0; v < 3; ++v) {
-      alignas(32) std::array<std::uint32_t, 8> lo, hi;
-      _mm256_store_si256(reinterpret_cast<__m256i*>(lo.data()), lowest[v]);
-      _mm256_store_si256(reinterpret_cast<__m256i*>(hi.data()), highest[v]);
-      for (int lane = 0; lane < 8; ++lane) {
-        const int word = 8 * v + lane, axis = word % 3;
-        if (word % 6 < 3)
-          bounds->lo[axis] = std::min(bounds->lo[axis], lo[lane]);
-        else
-          bounds->hi[axis] = std::max(bounds->hi[axis], hi[lane]);
-      }
-    }
-  }
+  if constexpr (kBounds) mergeLanesAvx2(lowest, highest, *bounds);
   return i;
 }
 
@@ -319,13 +326,7 @@ struct NarrowMap {
 }  // namespace
 
 void detail::narrowKeysScalar(std::span<const KeyBox> cell, unsigned width, std::span<KeyBox> out) {
-  KeyBounds bounds;
-  for (const KeyBox& b : cell)
-    for (int a = 0; a < 3; ++a) {
-      bounds.lo[a] = std::min(bounds.lo[a], b.min[a]);
-      bounds.hi[a] = std::max(bounds.hi[a], b.max[a]);
-    }
-  const NarrowMap map(bounds, width);
+  const NarrowMap map(boundsOf(cell), width);
   for (std::size_t i = 0; i < cell.size(); ++i)
     for (int a = 0; a < 3; ++a) {
       out[i].min[a] = map(cell[i].min[a], a);
@@ -337,9 +338,8 @@ namespace {
 
 #if defined(__x86_64__)
 // The same with AVX2, four boxes (three vectors) a step, both passes over a
-// cell that sits in L1: lane l of vector v is word 8v + l of the four, axis
-// (8v + l) % 3, a min where (8v + l) % 6 < 3. The tail box by box. No
-// lambdas: they would not inherit the target attribute.
+// cell that sits in L1, the lanes laid out as in mergeLanesAvx2. The tail
+// box by box. No lambdas: they would not inherit the target attribute.
 __attribute__((target("avx2"))) void narrowAvx2(std::span<const KeyBox> cell, unsigned width, std::span<KeyBox> out) {
   const std::size_t n = cell.size(), whole = n / 4 * 4;
   const auto* from = reinterpret_cast<const char*>(cell.data());
@@ -356,23 +356,8 @@ __attribute__((target("avx2"))) void narrowAvx2(std::span<const KeyBox> cell, un
       most[v] = _mm256_max_epu32(most[v], k);
     }
   KeyBounds bounds;
-  for (int v = 0; v < 3; ++v) {
-    alignas(32) std::uint32_t l[8], h[8];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(l), least[v]);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(h), most[v]);
-    for (int lane = 0; lane < 8; ++lane) {
-      const int word = 8 * v + lane, axis = word % 3;
-      if (word % 6 < 3)
-        bounds.lo[axis] = std::min(bounds.lo[axis], l[lane]);
-      else
-        bounds.hi[axis] = std::max(bounds.hi[axis], h[lane]);
-    }
-  }
-  for (std::size_t i = whole; i < n; ++i)
-    for (int a = 0; a < 3; ++a) {
-      bounds.lo[a] = std::min(bounds.lo[a], cell[i].min[a]);
-      bounds.hi[a] = std::max(bounds.hi[a], cell[i].max[a]);
-    }
+  mergeLanesAvx2(least, most, bounds);
+  for (std::size_t i = whole; i < n; ++i) addBox(cell[i], bounds);
   const NarrowMap map(bounds, width);
   __m256i lo[3], hi[3], shift[3];
   for (int v = 0; v < 3; ++v) {

@@ -52,8 +52,8 @@ KeyBounds boundsOf(std::span<const KeyBox> boxes);
 void narrowKeys(std::span<const KeyBox> cell, unsigned width, std::span<KeyBox> out);
 
 namespace detail {
-/// narrowKeys without its checks and without SIMD (what CPUs without AVX2
-/// run; the tests compare the two).
+/// narrowKeys without its checks and without AVX2 (what CPUs without it run:
+/// the map box by box, the bounds by boundsOf; the tests compare the two).
 void narrowKeysScalar(std::span<const KeyBox> cell, unsigned width, std::span<KeyBox> out);
 }  // namespace detail
 

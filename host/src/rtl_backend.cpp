@@ -94,7 +94,7 @@ ModelBackend modelOfBuiltHardware(std::optional<unsigned> keyWidth) {
 
 std::size_t resultBeatBytesOfBuiltHardware() { return (2 * BPACCEL_INDEX_WIDTH + BPACCEL_M + 7) / 8; }
 
-std::size_t loadBoxBytesOfBuiltHardware() { return (6 * BPACCEL_KEY_WIDTH + 7) / 8; }
+std::size_t loadBoxBytesOfBuiltHardware() { return loadBoxBytes(BPACCEL_KEY_WIDTH); }
 
 void RtlBackend::settle() {
   top_->clock = 0;

@@ -161,7 +161,8 @@ int main(int argc, char** argv) {
         double decoded = 0;
         for (const auto& r : t.phase->runs()) decoded += r.decodeSeconds;
         t.decode.push_back(decoded);
-        model.bytesPerBox = (6.0 * t.keyWidth) / 8;  // the link carries the device's keys
+        // The link carries the device's keys.
+        model.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(t.keyWidth));
         t.pipelined.push_back(bpaccel::modelPipeline(t.phase->runs(), hostSeconds, model).frameSeconds);
         std::sort(pairs.begin(), pairs.end());
         if (pairs != exact[f]) {
