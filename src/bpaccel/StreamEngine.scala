@@ -317,14 +317,22 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // ones before it down. (Written by lane, the top lane's 192 bits went to
   // all m lanes of aNext, across the window: with the head registers'
   // broadcast, stream m = 64 did not route.)
-  val capture     = RegInit(0.U(m.W)) // one-hot: which of the block's first m issues this is, 0 after them
-  val captureNext = WireDefault(capture)
-  capture := captureNext
-  val capturing      = RegInit(false.B) // capture =/= 0, as a register
+  // A count, not a one-hot of m bits: the block change's set of that
+  // one-hot sent issue && hasNextBlock to 128 flip-flops, which pulled its
+  // LUT across the device (stream m = 128's critical path, 55.5 MHz:
+  // issuing -> advance -> that LUT at column 4 -> the enable of `s`, 16.8 ns of routing).
+  val captureLeft    = RegInit(0.U(log2Ceil(m + 1).W)) // of the block's first m issues, those still to come
+  val captureLast    = RegInit(false.B) // captureLeft == 1, as a register
+  val capturing      = RegInit(false.B) // captureLeft =/= 0, as a register
   val capturingCarry = WireDefault(capturing) // its next value unless a start is accepted
   val capturingNext  = Mux(io.prepare.valid, true.B, capturingCarry)
   capturing := capturingNext
-  assert(capturing === capture.orR, "the capture flag does not match its count")
+  private def restartCapture(): Unit = {
+    captureLeft := m.U
+    captureLast := (m == 1).B
+  }
+  assert(capturing === (captureLeft =/= 0.U) && captureLast === (captureLeft === 1.U),
+    "the capture flags do not match their count")
   // Each lane's enable is a register computed a cycle ahead, as the window's
   // and the A block's are: `issuing` reached lane k's 192 enables through
   // issue && capture(k) (stream m = 64's critical path, 83.7 MHz, 11.0 ns of wire).
@@ -409,8 +417,9 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       laneTop  := laneTop - 1.U
       leftIsOne := left === 2.U
       blockEndCarry := leftIsOne
-      captureNext := (capture << 1)(m - 1, 0)
-      capturingCarry := capturing && !capture(m - 1)
+      when(capturing) { captureLeft := captureLeft - 1.U }
+      captureLast    := captureLeft === 2.U
+      capturingCarry := capturing && !captureLast
     }.elsewhen(hasNextBlock) {
       // A bipartite block that jumps starts with lane 0 at virtual object
       // n-1-left: the lanes from the jump on hold it + k, the prefix's lanes
@@ -428,7 +437,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
       aLeftAtLeast2m     := aLeft >= (3 * m).U
       blockEndCarry     := blockLeftIsM // nextLeft == 0: bipartiteLeft >= 1
       hasNextBlockCarry := aLeftAtLeast2m
-      captureNext  := 1.U
+      restartCapture()
       capturingCarry := true.B
     }.otherwise {
       issuingNext := false.B
@@ -479,7 +488,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     blockEndNext     := count === 2.U // block 0 ends at once: left0 == 0
     hasNextBlockNext := Mux(bipartite, split > (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 1 else 0)).U,
       count >= (m + (if (p.has(Fault.SkipSecondBlockAtMPlus2)) 3 else 2)).U) // lastA >= m
-    captureNext := 1.U
+    restartCapture()
     rBase      := 0.U
     rBlockLeft := count - 2.U
     rALeft     := Mux(bipartite, split - 1.U, count - 2.U)
@@ -540,9 +549,9 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   compare.io.a := VecInit(a.map(boxOf))
   compare.io.b := VecInit(window.map(boxOf))
   val compared = RegNext(compare.io.compares)
-  val atCompare = Pipe(issue, meta)
+  val atCompare = sampled(issue, meta)
   val hits = hitRegisters(ComparatorArray.hits(compared) & atCompare.bits.laneMask)
-  val atAnd     = Pipe(atCompare)
+  val atAnd     = sampled(atCompare.valid, atCompare.bits)
   require(p.pipelineLatency == 2)
 
   io.activity.active   := active
@@ -550,6 +559,17 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   io.activity.stalled  := issuing && !advance
   io.activity.inFlight := atCompare.valid.asUInt +& atAnd.valid.asUInt
   io.activity.retired  := atAnd.valid
+
+  /** `Pipe` without the enable on its bits: they are sampled every cycle,
+    * since only a valid stage's are read. Pipe's enable sent `issue` to the
+    * m lane mask registers of each stage.
+    */
+  private def sampled[T <: Data](valid: Bool, bits: T): Valid[T] = {
+    val stage = Wire(Valid(chiselTypeOf(bits)))
+    stage.valid := RegNext(valid, false.B)
+    stage.bits  := RegNext(bits)
+    stage
+  }
 
   /** Lane k + by of `lanes` in lane k (the debug port's probes only). */
   private def alignDown(lanes: Seq[UInt], by: UInt): Vec[UInt] = {
