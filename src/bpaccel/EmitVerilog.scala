@@ -45,7 +45,8 @@ object EmitVerilog {
     * 0 under `headShift_replica8`): from one CHIRRTL file, 1 in 24 and 8 in
     * 36 runs of firtool gave a different StreamEngine.sv, and a CI build of
     * such a file computed wrong pairs. With the option, 60 runs gave one
-    * file, with each copy under its own `headCopy` enable.
+    * file, with each copy under its own `headCopy` enable; [[LaneEnables]]
+    * checks every emission for it.
     */
   val firtoolOptions: Array[String] = Array(
     "--emit-separate-always-blocks",
@@ -65,6 +66,8 @@ object EmitVerilog {
     SingleClockMemories.rewrite(targetDir)
     // No read meets a write at the same row, so the block RAM needs no collision bypass.
     NoCollisionMemories.rewrite(targetDir)
+    // Each lane's registers under their own lane's enables (a firtool miscompile this has seen).
+    LaneEnables.check(p, targetDir)
     Files.writeString(targetDir.resolve("bpaccel_params.h"), CHeader(p))
     Files.writeString(targetDir.resolve(lintWaivers), lintWaiverText)
     targetDir.resolve("filelist.f")
