@@ -258,11 +258,12 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     copies = m + 1,
     unless = RegNext(io.loadClear, false.B)
   )
+  val laneBox = toLanes(loadedBox.bits)
   for (k <- 0 to m) when(headShift(k)) {
     if (k == m) {
-      headRegs(k).box := loadedBox.bits.box.asUInt
+      headRegs(k).box := laneBox.box.asUInt
       headRegs(k).inB := DontCare // set by lane at the copy into the window
-      headRegs(k).tag := tagOf(loadedBox.bits.index)
+      headRegs(k).tag := tagOf(laneBox.index)
     } else headRegs(k) := headRegs(k + 1)
   }
   // The window and aNext follow the head registers in every cycle after one
@@ -288,7 +289,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   // ---- the window: lane k holds object s+k ----
   val window = Reg(Vec(m, new Entry))
-  val entry  = headEntry
+  val entry  = toLanes(headEntry)
   val windowShift = replicatedEnable(
     "windowShift",
     next = issuingNext && (io.room || p.has(Fault.LookaheadIgnoresRoom).B),
@@ -298,10 +299,11 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // Lane k then holds object k+1-d, in B when k+1 >= split + d (`splitLane`, 0 for a triangular run).
   private val copiedToLane = if (p.has(Fault.HeadCopyOffByOne)) 0 else 1
   val splitLane = Reg(UInt(p.countWidth.W))
+  val laneSplit = toLanes(splitLane)
   for (k <- 0 until m) {
     when(headCopy(k)) {
       window(k)     := headRegs(k + copiedToLane)
-      window(k).inB := (k + 1).U >= splitLane
+      window(k).inB := (k + 1).U >= laneSplit
     }.elsewhen(windowShift(k)) {
       window(k) := (if (k == m - 1) entry else window(k + 1))
     }
@@ -520,11 +522,10 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     val probeI   = Vec(m, UInt(p.indexWidth.W)) // only with the debug port
     val probeJ   = Vec(m, UInt(p.indexWidth.W))
   }
-  val meta = Wire(new Meta)
-  meta.iBase    := base
-  meta.jBase    := s
-  meta.shift    := headOffset
-  meta.laneMask := VecInit(Seq.tabulate(m)(k =>
+  // The issue's own fields, in control time, each lane's mask without its
+  // B flag computed beside the counters; the lanes get them a cycle later,
+  // as registers.
+  val laneHasObjects = VecInit(Seq.tabulate(m)(k =>
     // Lane k holds object s+k-d, which exists while n - s > k - d, i.e.
     // laneTop >= k: from a register directly, not from n - s (that
     // subtraction in front of the compares was stream m = 32's critical
@@ -533,12 +534,20 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     // past the last A object.
     headOffset <= k.U &&
       (if (p.has(Fault.LaneMaskOneTooWide)) laneTop +& 1.U >= k.U else laneTop >= k.U) &&
-      (aTop >= k.U || p.has(Fault.BipartiteALanesUnmasked).B) && window(k).inB)).asUInt
+      (aTop >= k.U || p.has(Fault.BipartiteALanesUnmasked).B))).asUInt
+  val laneIssue   = RegNext(issue, false.B) // reset: the result queue's credits count it in flight
+  val laneObjects = toLanes(laneHasObjects)
+  val laneOffset  = toLanes(headOffset)
+  val meta = Wire(new Meta)
+  meta.iBase    := toLanes(base(p.indexWidth - 1, 0))
+  meta.jBase    := toLanes(s(p.indexWidth - 1, 0))
+  meta.shift    := laneOffset
+  meta.laneMask := laneObjects & VecInit(window.map(_.inB)).asUInt
   if (p.debugPort) {
     // The objects each lane really holds, from the tags that travelled with
     // the data, moved down by d lanes as the hit mask is.
-    meta.probeI := alignDown(a.map(_.tag), headOffset)
-    meta.probeJ := alignDown(window.map(_.tag), headOffset)
+    meta.probeI := alignDown(a.map(_.tag), laneOffset)
+    meta.probeJ := alignDown(window.map(_.tag), laneOffset)
   } else {
     meta.probeI := DontCare
     meta.probeJ := DontCare
@@ -549,15 +558,15 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   compare.io.a := VecInit(a.map(boxOf))
   compare.io.b := VecInit(window.map(boxOf))
   val compared = RegNext(compare.io.compares)
-  val atCompare = sampled(issue, meta)
+  val atCompare = sampled(laneIssue, meta)
   val hits = hitRegisters(ComparatorArray.hits(compared) & atCompare.bits.laneMask)
   val atAnd     = sampled(atCompare.valid, atCompare.bits)
-  require(p.pipelineLatency == 2)
+  require(p.pipelineLatency == 1 + 2) // the lanes' lag, compare, AND
 
   io.activity.active   := active
   io.activity.issued   := issue
   io.activity.stalled  := issuing && !advance
-  io.activity.inFlight := atCompare.valid.asUInt +& atAnd.valid.asUInt
+  io.activity.inFlight := laneIssue.asUInt +& atCompare.valid.asUInt +& atAnd.valid.asUInt
   io.activity.retired  := atAnd.valid
 
   /** `Pipe` without the enable on its bits: they are sampled every cycle,
@@ -578,13 +587,26 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     VecInit(Seq.tabulate(m)(k => shifted(k * w + w - 1, k * w)))
   }
 
-  /** One register per lane (`copies` of them) holding `next` of the last
-    * cycle, checked to equal `now` except in a cycle where `unless` holds
-    * (a look-ahead that may differ there says why that is harmless): each copy drives one lane's 192
-    * clock enables, where one net drove all 192m (stream m = 64's critical
-    * path: 12.4 ns of routing to about 12,000 flip-flops). Synthesis merges
-    * identical registers unless told otherwise; the FPGA flow keeps the
-    * copies by name (docs/fpga.md).
+  /** `x` as the lanes see it: one cycle late (see [[replicatedEnable]]). */
+  private def toLanes[T <: Data](x: T): T = {
+    val late = Reg(chiselTypeOf(x)) // RegNext would leave the width to inference, which shiftDown needs now
+    late := x
+    late
+  }
+
+  /** One register per lane (`copies` of them) holding `next` of two cycles
+    * ago, `now` of the last, checked to be so except in a cycle after one
+    * where `unless` holds (a look-ahead that may differ there says why that
+    * is harmless): each copy drives one lane's 192 clock enables, where one
+    * net drove all 192m (stream m = 64's critical path: 12.4 ns of routing to
+    * about 12,000 flip-flops). Synthesis merges identical registers unless
+    * told otherwise; the FPGA flow keeps the copies by name (docs/fpga.md).
+    *
+    * Between the look-ahead and the lanes' copies sits one register per
+    * group of [[StreamEngine.LaneGroup]] lanes, so the lanes act one cycle
+    * after the control decides (their other inputs go through
+    * [[toLanes]]): the look-ahead's logic and the wire across the die to
+    * the far lanes were one cycle (stream m = 128's critical paths, 55.5 MHz).
     */
   private def replicatedEnable(
     name: String,
@@ -593,14 +615,17 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     copies: Int = m,
     unless: Bool = false.B
   ): Seq[Bool] = {
-    // The reset enters once, at the source: reset on each copy sent the
-    // wrapper's reset register to every lane (stream m = 64's critical path,
-    // 60.2 MHz, 15.6 ns of routing). The same function as a reset copy's:
-    // each holds 0 in the cycle after a reset cycle, `next` of the last one otherwise.
-    val gated = next && !reset.asBool
+    // The reset enters once per group, never per lane: reset on each copy
+    // sent the wrapper's reset register to every lane (stream m = 64's
+    // critical path, 60.2 MHz, 15.6 ns of routing). A lane copy may hold
+    // anything in the first cycle after a one-cycle reset: no box has been
+    // loaded then, so what it shifts or copies is never compared.
+    val groups = Seq.tabulate((copies + StreamEngine.LaneGroup - 1) / StreamEngine.LaneGroup)(g =>
+      RegNext(next, false.B).suggestName(s"${name}_replica_group$g"))
+    val settled = !RegNext(reset.asBool, true.B)
     Seq.tabulate(copies) { k =>
-      val copy = RegNext(gated).suggestName(s"${name}_replica$k")
-      assert(copy === now || unless, s"the look-ahead of $name is wrong")
+      val copy = RegNext(groups(k / StreamEngine.LaneGroup)).suggestName(s"${name}_replica$k")
+      assert(copy === RegNext(now) || RegNext(unless) || !settled, s"the look-ahead of $name is wrong")
       copy
     }
   }
@@ -609,4 +634,9 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     if (p.has(Fault.RepeatLastBeat)) atAnd.valid || (RegNext(atAnd.valid, false.B) && !atAnd.valid) else atAnd.valid
   emit(outValid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, atAnd.bits.probeI, atAnd.bits.probeJ, hits,
     shiftDown = atAnd.bits.shift)
+}
+
+object StreamEngine {
+  /** Lanes served by one register of each enable's first stage. */
+  val LaneGroup = 8
 }
