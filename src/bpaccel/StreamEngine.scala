@@ -46,7 +46,9 @@ import chisel3.util._
   * in A, or whose A object is past na-1, are masked (see Schedule).
   *
   * Startup after the start: the first readLatency reads travel to the
-  * window's entry. Pipeline: comparator register, AND register.
+  * window's entry. The lanes (head chain, window, aNext, a) act a cycle
+  * after the control decides (see `replicatedEnable`). Pipeline: the lanes'
+  * lag, comparator register, AND register.
   */
 class StreamEngine(p: AccelParams) extends Engine(p) {
   private val m = p.m
@@ -622,10 +624,13 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     // loaded then, so what it shifts or copies is never compared.
     val groups = Seq.tabulate((copies + StreamEngine.LaneGroup - 1) / StreamEngine.LaneGroup)(g =>
       RegNext(next, false.B).suggestName(s"${name}_replica_group$g"))
+    // What each copy is checked against, registered once for all of them.
     val settled = !RegNext(reset.asBool, true.B)
+    val nowLate = RegNext(now)
+    val excused = RegNext(unless) || !settled
     Seq.tabulate(copies) { k =>
       val copy = RegNext(groups(k / StreamEngine.LaneGroup)).suggestName(s"${name}_replica$k")
-      assert(copy === RegNext(now) || RegNext(unless) || !settled, s"the look-ahead of $name is wrong")
+      assert(copy === nowLate || excused, s"the look-ahead of $name is wrong")
       copy
     }
   }
