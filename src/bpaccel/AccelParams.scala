@@ -160,12 +160,12 @@ case class AccelParams(
   /** Cycles from an issue to its hit mask at the result queue. Seed: memory
     * read, memory output registers, rotator register, comparator register, AND
     * register. Stream: the operands are already registers; the lanes' lag
-    * (they act a cycle after the control, see StreamEngine's
+    * (they act StreamEngine.LaneLag cycles after the control, see its
     * replicatedEnable), comparator register, AND register.
     */
   val pipelineLatency: Int = arch match {
     case Arch.Seed   => 1 + memoryOutputStages + 3
-    case Arch.Stream => 3
+    case Arch.Stream => StreamEngine.LaneLag + 2
   }
 
   /** Cycles a run of n >= 2 objects takes after its issue cycles when the

@@ -114,20 +114,25 @@ class RunControl(p: AccelParams) extends Module {
     loadCycles := loadCycles + 1.U
   }
 
+  // The issue and stall counts take the engine's flags a cycle late, from
+  // registers of their own: `issue` drove these 128 flip-flops directly and
+  // pulled its LUT away from the engine's control (stream m = 128's critical
+  // path, 60.6 MHz). The last issue or stall of a run comes at least
+  // pipelineLatency cycles before its done, so its count lands while busy.
+  val issuedLate  = RegNext(io.engine.issued, false.B)
+  val stalledLate = RegNext(io.engine.stalled, false.B)
+  assert(busy || !(issuedLate || stalledLate), "an issue or stall was counted after its run ended")
   when(busy) {
     cycles := cycles + 1.U
-    when(io.engine.issued) {
-      issueCycles := issueCycles + 1.U
-    }.elsewhen(io.engine.stalled) {
-      stallCycles := stallCycles + 1.U
-    }.elsewhen(!io.engine.active) {
-      // Draining: the first runOverheadCycles cycles are the pipeline's
-      // fixed latency; any beyond are spent waiting for the consumer.
-      when(drainCycles === p.runOverheadCycles.U) {
-        stallCycles := stallCycles + 1.U
-      }.otherwise {
-        drainCycles := drainCycles + 1.U
-      }
+    when(issuedLate) { issueCycles := issueCycles + 1.U }
+    // Draining: the first runOverheadCycles cycles are the pipeline's fixed
+    // latency; any beyond are spent waiting for the consumer. A drain
+    // follows the last issue or stall by a cycle at least, so the two
+    // stall counts never meet.
+    val drainStall = !io.engine.active && drainCycles === p.runOverheadCycles.U
+    when(stalledLate || drainStall) { stallCycles := stallCycles + 1.U }
+    when(!io.engine.active) {
+      when(drainCycles =/= p.runOverheadCycles.U) { drainCycles := drainCycles + 1.U }
       val drained = if (p.has(Fault.DoneBeforeQueueEmpty)) true.B else io.queueEmpty
       when(io.engine.inFlight === 0.U && drained) {
         busy := false.B

@@ -46,9 +46,10 @@ import chisel3.util._
   * in A, or whose A object is past na-1, are masked (see Schedule).
   *
   * Startup after the start: the first readLatency reads travel to the
-  * window's entry. The lanes (head chain, window, aNext, a) act a cycle
-  * after the control decides (see `replicatedEnable`). Pipeline: the lanes'
-  * lag, comparator register, AND register.
+  * window's entry. The lanes (head chain, window, aNext, a) act
+  * StreamEngine.LaneLag cycles after the control decides (see
+  * `replicatedEnable`). Pipeline: the lanes' lag, comparator register, AND
+  * register.
   */
 class StreamEngine(p: AccelParams) extends Engine(p) {
   private val m = p.m
@@ -525,7 +526,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     val probeJ   = Vec(m, UInt(p.indexWidth.W))
   }
   // The issue's own fields, in control time, each lane's mask without its
-  // B flag computed beside the counters; the lanes get them a cycle later,
+  // B flag computed beside the counters; the lanes get them LaneLag cycles later,
   // as registers.
   val laneHasObjects = VecInit(Seq.tabulate(m)(k =>
     // Lane k holds object s+k-d, which exists while n - s > k - d, i.e.
@@ -537,7 +538,8 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     headOffset <= k.U &&
       (if (p.has(Fault.LaneMaskOneTooWide)) laneTop +& 1.U >= k.U else laneTop >= k.U) &&
       (aTop >= k.U || p.has(Fault.BipartiteALanesUnmasked).B))).asUInt
-  val laneIssue   = RegNext(issue, false.B) // reset: the result queue's credits count it in flight
+  // With a reset: the result queue's credits count these stages in flight.
+  val laneIssue   = ShiftRegisters(issue, StreamEngine.LaneLag, false.B, true.B)
   val laneObjects = toLanes(laneHasObjects)
   val laneOffset  = toLanes(headOffset)
   val meta = Wire(new Meta)
@@ -560,15 +562,15 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   compare.io.a := VecInit(a.map(boxOf))
   compare.io.b := VecInit(window.map(boxOf))
   val compared = RegNext(compare.io.compares)
-  val atCompare = sampled(laneIssue, meta)
+  val atCompare = sampled(laneIssue.last, meta)
   val hits = hitRegisters(ComparatorArray.hits(compared) & atCompare.bits.laneMask)
   val atAnd     = sampled(atCompare.valid, atCompare.bits)
-  require(p.pipelineLatency == 1 + 2) // the lanes' lag, compare, AND
+  require(p.pipelineLatency == StreamEngine.LaneLag + 2) // the lanes' lag, compare, AND
 
   io.activity.active   := active
   io.activity.issued   := issue
   io.activity.stalled  := issuing && !advance
-  io.activity.inFlight := laneIssue.asUInt +& atCompare.valid.asUInt +& atAnd.valid.asUInt
+  io.activity.inFlight := PopCount(laneIssue :+ atCompare.valid :+ atAnd.valid)
   io.activity.retired  := atAnd.valid
 
   /** `Pipe` without the enable on its bits: they are sampled every cycle,
@@ -589,26 +591,37 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     VecInit(Seq.tabulate(m)(k => shifted(k * w + w - 1, k * w)))
   }
 
-  /** `x` as the lanes see it: one cycle late (see [[replicatedEnable]]). */
-  private def toLanes[T <: Data](x: T): T = {
-    val late = Reg(chiselTypeOf(x)) // RegNext would leave the width to inference, which shiftDown needs now
-    late := x
-    late
-  }
+  /** `x` as the lanes see it: [[StreamEngine.LaneLag]] cycles late (see [[replicatedEnable]]). */
+  private def toLanes[T <: Data](x: T): T =
+    (1 to StreamEngine.LaneLag).foldLeft(x) { (value, _) =>
+      val late = Reg(chiselTypeOf(value)) // RegNext would leave the width to inference, which shiftDown needs now
+      late := value
+      late
+    }
 
-  /** One register per lane (`copies` of them) holding `next` of two cycles
-    * ago, `now` of the last, checked to be so except in a cycle after one
-    * where `unless` holds (a look-ahead that may differ there says why that
+  /** One register per lane (`copies` of them) holding `now` of
+    * [[StreamEngine.LaneLag]] cycles ago, computed from `next` (its value a
+    * cycle ahead) and checked to be so except where `unless` held in the
+    * cycle of that `now` (a look-ahead that may differ there says why that
     * is harmless): each copy drives one lane's 192 clock enables, where one
     * net drove all 192m (stream m = 64's critical path: 12.4 ns of routing to
     * about 12,000 flip-flops). Synthesis merges identical registers unless
     * told otherwise; the FPGA flow keeps the copies by name (docs/fpga.md).
     *
-    * Between the look-ahead and the lanes' copies sits one register per
-    * group of [[StreamEngine.LaneGroup]] lanes, so the lanes act one cycle
-    * after the control decides (their other inputs go through
-    * [[toLanes]]): the look-ahead's logic and the wire across the die to
-    * the far lanes were one cycle (stream m = 128's critical paths, 55.5 MHz).
+    * The path to the copies is a chain, so that each cycle holds either
+    * logic or a long wire, never both:
+    *  - `<name>_replica_lead`: one register, beside the control, takes the
+    *    look-ahead's logic (the issue, credit, block-end and capture flags);
+    *  - `<name>_replica_group<g>`: one register per group of
+    *    [[StreamEngine.LaneGroup]] lanes, at the end of the wire across the
+    *    die;
+    *  - `<name>_replica<k>`: each lane's copy.
+    * So the lanes act LaneLag cycles after the control decides, and their
+    * other inputs come through [[toLanes]]. With one cycle of lag the
+    * look-ahead's logic and the wire to the far groups were one cycle
+    * (stream m = 128's critical path, 60.6 MHz: `issuing` -> `advance`,
+    * placed 40 rows away -> 4 LUT levels -> an `aNextShift` group register,
+    * 14.8 ns of routing).
     */
   private def replicatedEnable(
     name: String,
@@ -617,17 +630,21 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     copies: Int = m,
     unless: Bool = false.B
   ): Seq[Bool] = {
-    // The reset enters once per group, never per lane: reset on each copy
-    // sent the wrapper's reset register to every lane (stream m = 64's
-    // critical path, 60.2 MHz, 15.6 ns of routing). A lane copy may hold
-    // anything in the first cycle after a one-cycle reset: no box has been
-    // loaded then, so what it shifts or copies is never compared.
+    require(StreamEngine.LaneLag == 2, "the chain below is written for two cycles of lag")
+    // The reset enters at the lead alone, never per lane or group: reset on
+    // each copy sent the wrapper's reset register to every lane (stream
+    // m = 64's critical path, 60.2 MHz, 15.6 ns of routing). A group or lane
+    // register may hold anything in the first LaneLag cycles after a
+    // one-cycle reset: no box has been loaded then (the first box is written
+    // to a lane LaneLag + 1 cycles after it is offered), so what it shifts or
+    // copies is never compared.
+    val lead = RegNext(next, false.B).suggestName(s"${name}_replica_lead")
     val groups = Seq.tabulate((copies + StreamEngine.LaneGroup - 1) / StreamEngine.LaneGroup)(g =>
-      RegNext(next, false.B).suggestName(s"${name}_replica_group$g"))
+      RegNext(lead).suggestName(s"${name}_replica_group$g"))
     // What each copy is checked against, registered once for all of them.
-    val settled = !RegNext(reset.asBool, true.B)
-    val nowLate = RegNext(now)
-    val excused = RegNext(unless) || !settled
+    val afterReset = ShiftRegisters(reset.asBool, StreamEngine.LaneLag, true.B, true.B)
+    val nowLate    = ShiftRegister(now, StreamEngine.LaneLag)
+    val excused    = ShiftRegister(unless, StreamEngine.LaneLag) || afterReset.reduce(_ || _)
     Seq.tabulate(copies) { k =>
       val copy = RegNext(groups(k / StreamEngine.LaneGroup)).suggestName(s"${name}_replica$k")
       assert(copy === nowLate || excused, s"the look-ahead of $name is wrong")
@@ -642,6 +659,9 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 }
 
 object StreamEngine {
-  /** Lanes served by one register of each enable's first stage. */
+  /** Lanes served by one register of each enable's group stage. */
   val LaneGroup = 8
+
+  /** Cycles by which the lanes act after the control decides (see replicatedEnable). */
+  val LaneLag = 2
 }
