@@ -49,6 +49,7 @@ BENCH_ARGS ?=
 
 # The FPGA flow's own test runs on this configuration.
 FPGA_TEST_VERILOG := build/fpga-verilog/test-m2
+FPGA_TEST_STREAM_VERILOG := build/fpga-verilog/test-stream-m2
 
 .PHONY: all deps test test-hw test-host test-fpga host bench verilog fpga fpga-sweep clean \
         host-sanitize test-sanitize print-other-arch fuzz test-fuzz fuzz-long formal-long
@@ -163,12 +164,15 @@ fpga-sweep: deps
 	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --key-width $(KEY_WIDTH) --memory-style $(FPGA_MEMORY_STYLE) --verilog-root build/fpga-verilog --emit always --budget-min 60
 
 $(FPGA_TEST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
-	$(SBT) "runMain bpaccel.EmitVerilog --m 2 --target-dir $(FPGA_TEST_VERILOG)"
+	$(SBT) "runMain bpaccel.EmitVerilog --arch seed --m 2 --target-dir $(FPGA_TEST_VERILOG)"
+$(FPGA_TEST_STREAM_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
+	$(SBT) "runMain bpaccel.EmitVerilog --arch stream --m 2 --target-dir $(FPGA_TEST_STREAM_VERILOG)"
 # Options for flow.py, e.g. FPGA_ARGS="--router router2 --threads 2".
 FPGA_ARGS ?=
 
-test-fpga: deps $(FPGA_TEST_VERILOG)/filelist.f
-	$(PYTHON) scripts/fpga/test_flow.py $(FPGA_TEST_VERILOG)
+# Both architectures at m = 2, end to end.
+test-fpga: deps $(FPGA_TEST_VERILOG)/filelist.f $(FPGA_TEST_STREAM_VERILOG)/filelist.f
+	$(PYTHON) scripts/fpga/test_flow.py $(FPGA_TEST_VERILOG) $(FPGA_TEST_STREAM_VERILOG)
 
 # SystemVerilog (one file per module, filelist.f) and bpaccel_params.h for one configuration.
 verilog: deps

@@ -753,6 +753,20 @@ def parse_params(vdir: Path) -> dict:
     return out
 
 
+def source_revision() -> str | None:
+    """The commit the flow ran in, "-dirty" when the generator's sources
+    differ from it (make fpga emits the Verilog from that tree first), so a
+    report says which design it measured; None outside a git checkout."""
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short=7", "HEAD"], cwd=REPO, capture_output=True,
+                              text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--", "src", "build.sbt"], cwd=REPO,
+                               capture_output=True, text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return head + ("-dirty" if dirty else "")
+
+
 def base_report(m, capacity, params, args, versions, wrapper_info) -> dict:
     if params.get("m") is not None and params["m"] != m:
         raise FlowError(EXIT_INPUT, f"--m {m} but {args.verilog_dir}/bpaccel_params.h says m = {params['m']}")
@@ -764,6 +778,7 @@ def base_report(m, capacity, params, args, versions, wrapper_info) -> dict:
         "capacity": capacity,
         "key_width": params.get("key_width"),
         "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+        "source_revision": source_revision(),
         "host": {"machine": platform.machine(), "cpus": os.cpu_count()},
         "verilog_dir": str(args.verilog_dir),
         "part": {"ecp5": f"{ECP5_PART} {ECP5_PACKAGE} speed {ECP5_SPEED} (nextpnr-ecp5 {ECP5_DEVICE_FLAG} --package {ECP5_PACKAGE})",

@@ -231,7 +231,7 @@ def fmt(x, nd=0):
 def render(sweep: dict) -> str:
     rows = []
     head = ("| m | capacity | memories | ECP5 LUT4 | ECP5 FF | DP16KD | **Fmax (MHz)** | pair tests/s = m × Fmax | "
-            "xc7 LUT | xc7 FF | xc7 RAMB18 | flow wall time |")
+            "xc7 LUT | xc7 FF | xc7 RAMB18 | flow wall time | revision, placer seed |")
     rows.append(head)
     rows.append("|---:" * (head.count("|") - 1) + "|")
     notes = []
@@ -240,21 +240,23 @@ def render(sweep: dict) -> str:
         d = e.get("data")
         st = e.get("status")
         wall = f"{e['wall_s'] / 60:.1f} min" if e.get("wall_s") else "–"
+        # Reports from before the flow recorded its revision show "–": the text names it.
+        run = f"{(d or {}).get('source_revision') or '–'}, {(d or {}).get('nextpnr_seed', '–')}"
         if st == "ok":
             ec, x = d["ecp5"], d.get("xilinx_estimate") or {}
             rows.append(f"| {m} | {fmt(d['capacity'])} | {d.get('memory_style', 'inferred')} | {fmt(ec['luts'])} | "
                         f"{fmt(ec['ffs'])} | {ec['bram_dp16kd']} | "
                         f"**{ec['fmax_mhz']:.1f}** | {m * ec['fmax_mhz'] / 1e3:.2f} G | {fmt(x.get('luts'))} | "
-                        f"{fmt(x.get('ffs'))} | {fmt(x.get('bram_ramb18e1'))} | {wall} |")
+                        f"{fmt(x.get('ffs'))} | {fmt(x.get('bram_ramb18e1'))} | {wall} | {run} |")
         elif st == "does_not_fit":
             dem = d["ecp5_demand"]["over_capacity"]
             why = ", ".join(f"{k} {v['used']}/{v['available']}" for k, v in dem.items()) or "see report"
             x = d.get("xilinx_estimate") or {}
             rows.append(f"| {m} | {fmt(d['capacity'])} | {d.get('memory_style', 'inferred')} | does not fit | | {why} | – | – | "
                         f"{fmt(x.get('luts'))} | "
-                        f"{fmt(x.get('ffs'))} | {fmt(x.get('bram_ramb18e1'))} | {wall} |")
+                        f"{fmt(x.get('ffs'))} | {fmt(x.get('bram_ramb18e1'))} | {wall} | {run} |")
         else:
-            rows.append(f"| {m} | | | {st.replace('_', ' ')} (below) | | | | | | | | |")
+            rows.append(f"| {m} | | | {st.replace('_', ' ')} (below) | | | | | | | | | |")
             notes.append(f"* m = {m}: {e.get('reason', '')}")
     arch = sweep.get("arch", "seed")
     key_width = sweep.get("key_width", 32)

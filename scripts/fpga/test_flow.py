@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""The FPGA flow end to end on a small configuration (m = 2): a real
-synthesis, place and route, and a report with every field the benchmark and
-the docs rely on. Run by `make test-fpga` (part of `make test`) as
-`python3 scripts/fpga/test_flow.py <verilog-dir>`."""
+"""The FPGA flow end to end on small configurations (m = 2 of each
+architecture): a real synthesis, place and route, and a report with every
+field the benchmark and the docs rely on. Run by `make test-fpga` (part of
+`make test`) as `python3 scripts/fpga/test_flow.py <seed-m2-dir> <stream-m2-dir>`."""
 import json
 import subprocess
 import sys
@@ -12,17 +12,25 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))  # flow.py's functions, for the tests that need no tools
-VERILOG_DIR: Path
+VERILOG_DIRS: dict[str, Path] = {}
 
 
 class FlowOnSmallConfiguration(unittest.TestCase):
+    """The seed's architecture at m = 2: 6m striped memories."""
+    ARCH = "seed"
+    MEMORY_INSTANCES = 12  # 6 coordinates x 2 lanes, each 256 x 32 bits
+
+    @classmethod
+    def verilog_dir(cls) -> Path:
+        return VERILOG_DIRS[cls.ARCH]
+
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.out = Path(cls.tmp.name) / "m2.json"
         cls.flow = subprocess.run(
-            [sys.executable, str(HERE / "flow.py"), "--verilog-dir", str(VERILOG_DIR), "--m", "2",
-             "--out", str(cls.out), "--work-dir", str(HERE.parent.parent / "build" / "fpga-test-work"),
+            [sys.executable, str(HERE / "flow.py"), "--verilog-dir", str(cls.verilog_dir()), "--m", "2",
+             "--out", str(cls.out), "--work-dir", str(HERE.parent.parent / "build" / f"fpga-test-work-{cls.ARCH}"),
              "--no-breakdown"],
             capture_output=True, text=True)
 
@@ -39,6 +47,9 @@ class FlowOnSmallConfiguration(unittest.TestCase):
         self.assertEqual(r["status"], "ok")
         self.assertTrue(r["fits"])
         self.assertEqual(r["m"], 2)
+        self.assertEqual(r["arch"], self.ARCH)
+        # The commit of the design it measured (this test runs in a clone).
+        self.assertRegex(r["source_revision"] or "", r"^[0-9a-f]{7}(-dirty)?$")
         e = r["ecp5"]
         self.assertGreater(e["fmax_mhz"], 10)
         self.assertLess(e["fmax_mhz"], 1000)
@@ -50,16 +61,42 @@ class FlowOnSmallConfiguration(unittest.TestCase):
         e = r["ecp5"]
         self.assertGreater(e["luts"], 100)
         self.assertGreater(e["ffs"], 100)
-        # 6 coordinates x 2 lanes, each 256 x 32 bits: at least one DP16KD each.
-        self.assertGreaterEqual(e["bram_dp16kd"], 12)
+        # At least one DP16KD a memory.
+        self.assertGreaterEqual(e["bram_dp16kd"], self.MEMORY_INSTANCES)
         self.assertTrue(r["memories"]["memories_in_bram"])
-        self.assertEqual(r["memories"]["instances"], 12)
+        self.assertEqual(r["memories"]["instances"], self.MEMORY_INSTANCES)
 
     def test_adds_a_xilinx_estimate(self):
         x = self.report()["xilinx_estimate"]
         self.assertGreater(x["luts"], 100)
         self.assertGreater(x["bram_ramb18e1"] + 2 * x["bram_ramb36e1"], 0)
 
+
+class FlowOnSmallStreamConfiguration(FlowOnSmallConfiguration):
+    """The stream architecture at m = 2, the FPGA targets' default: one memory
+    of six keys a row, and the lanes' enable copies (`*_replica*`), which the
+    flow must keep from being merged back into one register."""
+    ARCH = "stream"
+    MEMORY_INSTANCES = 1
+
+    def test_keeps_every_lane_enable_copy(self):
+        self.report()
+        work = HERE.parent.parent / "build" / f"fpga-test-work-{self.ARCH}"
+        netlist = json.loads((work / "ecp5.json").read_text())
+        nets = {name: tuple(net["bits"]) for mod in netlist["modules"].values()
+                for name, net in mod.get("netnames", {}).items()}
+
+        def bits(copy: str):
+            found = [b for name, b in nets.items() if name.endswith(copy)]
+            self.assertTrue(found, f"no net {copy} in the synthesised netlist")
+            return found[0]
+        # Lanes 0 and 1 share a group register, so their copies have the same
+        # input: merged (opt_merge), their names would be aliases of one net.
+        for enable in ("windowShift", "aLoad", "headCopy", "headShift", "aNextShift"):
+            self.assertNotEqual(bits(f"{enable}_replica0"), bits(f"{enable}_replica1"), enable)
+
+
+class FlowRefusesBadInput(unittest.TestCase):
     def test_fails_loudly_on_bad_input(self):
         with tempfile.TemporaryDirectory() as empty:
             run = subprocess.run([sys.executable, str(HERE / "flow.py"), "--verilog-dir", empty, "--m", "2",
@@ -93,7 +130,7 @@ class MemoryWithoutCollisionBypass(unittest.TestCase):
             return json.loads((work / "stat.json").read_text())["modules"]["\\top"]["num_cells_by_type"]
 
     def test_maps_each_memory_to_a_dp16kd_without_logic(self):
-        memories = sorted(VERILOG_DIR.glob("mem_*.sv"))
+        memories = sorted(VERILOG_DIRS["seed"].glob("mem_*.sv"))
         self.assertTrue(memories)
         path = memories[0]
         name = path.stem
@@ -141,7 +178,8 @@ class RegisteredMemorySubstitution(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) < 2:
-        sys.exit("usage: test_flow.py <verilog-dir with filelist.f for m=2>")
-    VERILOG_DIR = Path(sys.argv.pop(1)).resolve()
+    if len(sys.argv) < 3:
+        sys.exit("usage: test_flow.py <seed m=2 verilog dir> <stream m=2 verilog dir> (each with filelist.f)")
+    VERILOG_DIRS["seed"] = Path(sys.argv.pop(1)).resolve()
+    VERILOG_DIRS["stream"] = Path(sys.argv.pop(1)).resolve()
     unittest.main(verbosity=2)
