@@ -434,6 +434,7 @@ def main(argv: list[str] | None = None) -> int:
 def flow(args) -> int:
     t_start = time.monotonic()
     deadline = t_start + args.timeout if args.timeout else None
+    revision = source_revision()  # at the start: commits made while nextpnr runs are not what it measures
     m = args.m
     if m < 1:
         raise FlowError(EXIT_INPUT, "--m must be >= 1")
@@ -551,7 +552,7 @@ def flow(args) -> int:
     util = nextpnr_utilisation(ntext)
     over = {k: v for k, v in util.items() if v["used"] > v["available"]}
     nofit_msg = re.search(r"ERROR:.*(no BELs remaining|not enough|Unable to place|exceed|fit)", ntext, re.I)
-    result: dict = base_report(m, capacity, params, args, versions, wrapper_info)
+    result: dict = base_report(m, capacity, params, args, versions, wrapper_info, revision)
     xil = None
     if code != 0:
         if over or nofit_msg:
@@ -767,7 +768,7 @@ def source_revision() -> str | None:
     return head + ("-dirty" if dirty else "")
 
 
-def base_report(m, capacity, params, args, versions, wrapper_info) -> dict:
+def base_report(m, capacity, params, args, versions, wrapper_info, revision: str | None = None) -> dict:
     if params.get("m") is not None and params["m"] != m:
         raise FlowError(EXIT_INPUT, f"--m {m} but {args.verilog_dir}/bpaccel_params.h says m = {params['m']}")
     return {
@@ -778,7 +779,7 @@ def base_report(m, capacity, params, args, versions, wrapper_info) -> dict:
         "capacity": capacity,
         "key_width": params.get("key_width"),
         "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-        "source_revision": source_revision(),
+        "source_revision": revision,
         "host": {"machine": platform.machine(), "cpus": os.cpu_count()},
         "verilog_dir": str(args.verilog_dir),
         "part": {"ecp5": f"{ECP5_PART} {ECP5_PACKAGE} speed {ECP5_SPEED} (nextpnr-ecp5 {ECP5_DEVICE_FLAG} --package {ECP5_PACKAGE})",
