@@ -117,7 +117,14 @@ DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std:
     if (const int reportKeys = j.value("key_width", 32); reportKeys != keyWidth)
       return fallback(fmt::format("{} is for {}-bit keys, not {}", fpgaReport, reportKeys, keyWidth));
     const double mhz = j.at("ecp5").at("fmax_mhz").get<double>();
-    if (mhz > 0) return {mhz * 1e6, fmt::format("Fmax {:.2f} MHz measured by nextpnr on ECP5 ({})", mhz, fpgaReport)};
+    // Which design and placement it measured, where the report says (older ones do not).
+    std::string run;
+    if (const auto rev = j.find("source_revision"); rev != j.end() && rev->is_string())
+      run += fmt::format(", revision {}", rev->get<std::string>());
+    if (const auto seed = j.find("nextpnr_seed"); seed != j.end() && seed->is_number_integer())
+      run += fmt::format(", placer seed {}", seed->get<int>());
+    if (mhz > 0)
+      return {mhz * 1e6, fmt::format("Fmax {:.2f} MHz measured by nextpnr on ECP5 ({}{})", mhz, fpgaReport, run)};
     return fallback(fpgaReport + " has no positive Fmax");
   } catch (const std::exception& e) {
     return fallback(fmt::format("{} unreadable: {}", fpgaReport, e.what()));

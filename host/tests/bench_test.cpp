@@ -464,6 +464,16 @@ TEST(DeviceClock, TheDefaultClockIsTheFmaxOfAReportOfTheSameMAndArchitectureOnly
   const auto ok = clockFromFpgaReport(write("seed8.json", seed8), 8, "seed");
   EXPECT_DOUBLE_EQ(ok.hz, 107.5e6);
   EXPECT_NE(ok.source.find("measured by nextpnr"), std::string::npos) << ok.source;
+  EXPECT_EQ(ok.source.find("revision"), std::string::npos) << ok.source;  // the report names none
+
+  // A report that names its design and placement: the clock's label says them.
+  auto named = seed8;
+  named["source_revision"] = "0b709b6";
+  named["nextpnr_seed"] = 3;
+  const auto labelled = clockFromFpgaReport(write("named.json", named), 8, "seed");
+  EXPECT_NE(labelled.source.find("revision 0b709b6, placer seed 3"), std::string::npos) << labelled.source;
+  named["source_revision"] = nullptr;  // the flow ran outside a git checkout
+  EXPECT_DOUBLE_EQ(clockFromFpgaReport(write("named.json", named), 8, "seed").hz, 107.5e6);
 
   // The other architecture's report at the same m must not set the clock.
   const auto otherArch = clockFromFpgaReport(write("seed8.json", seed8), 8, "stream");
