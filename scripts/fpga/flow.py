@@ -754,18 +754,22 @@ def parse_params(vdir: Path) -> dict:
     return out
 
 
+GENERATOR_SOURCES = ["src", "build.sbt"]
+
+
 def source_revision() -> str | None:
-    """The commit the flow ran in, "-dirty" when the generator's sources
-    differ from it (make fpga emits the Verilog from that tree first), so a
-    report says which design it measured; None outside a git checkout."""
+    """The design a report measured: the last commit that changed the
+    generator's sources (so commits of docs or scripts leave it alone),
+    "-dirty" when the working tree's sources differ from it (make fpga emits
+    the Verilog from that tree first); None outside a git checkout."""
     try:
-        head = subprocess.run(["git", "rev-parse", "--short=7", "HEAD"], cwd=REPO, capture_output=True,
-                              text=True, check=True).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--", "src", "build.sbt"], cwd=REPO,
+        head = subprocess.run(["git", "log", "-1", "--format=%h", "--abbrev=7", "--", *GENERATOR_SOURCES],
+                              cwd=REPO, capture_output=True, text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--", *GENERATOR_SOURCES], cwd=REPO,
                                capture_output=True, text=True, check=True).stdout.strip()
     except (OSError, subprocess.CalledProcessError):
         return None
-    return head + ("-dirty" if dirty else "")
+    return (head + ("-dirty" if dirty else "")) or None
 
 
 def base_report(m, capacity, params, args, versions, wrapper_info, revision: str | None = None) -> dict:
