@@ -28,10 +28,10 @@ class FlowOnSmallConfiguration(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.out = Path(cls.tmp.name) / "m2.json"
+        cls.work = HERE.parent.parent / "build" / f"fpga-test-work-{cls.ARCH}"
         cls.flow = subprocess.run(
             [sys.executable, str(HERE / "flow.py"), "--verilog-dir", str(cls.verilog_dir()), "--m", "2",
-             "--out", str(cls.out), "--work-dir", str(HERE.parent.parent / "build" / f"fpga-test-work-{cls.ARCH}"),
-             "--no-breakdown"],
+             "--out", str(cls.out), "--work-dir", str(cls.work), "--no-breakdown"],
             capture_output=True, text=True)
 
     @classmethod
@@ -81,8 +81,7 @@ class FlowOnSmallStreamConfiguration(FlowOnSmallConfiguration):
 
     def test_keeps_every_lane_enable_copy(self):
         self.report()
-        work = HERE.parent.parent / "build" / f"fpga-test-work-{self.ARCH}"
-        netlist = json.loads((work / "ecp5.json").read_text())
+        netlist = json.loads((self.work / "ecp5.json").read_text())
         nets = {name: tuple(net["bits"]) for mod in netlist["modules"].values()
                 for name, net in mod.get("netnames", {}).items()}
 
