@@ -91,7 +91,7 @@ class FlowOnSmallStreamConfiguration(FlowOnSmallConfiguration):
             return found[0]
         # Lanes 0 and 1 share a group register, so their copies have the same
         # input: merged (opt_merge), their names would be aliases of one net.
-        for enable in ("windowShift", "aLoad", "headCopy", "headShift", "aNextShift"):
+        for enable in ("windowWrite", "aLoad", "headCopy", "headShift", "aNextWrite"):
             self.assertNotEqual(bits(f"{enable}_replica0"), bits(f"{enable}_replica1"), enable)
 
 

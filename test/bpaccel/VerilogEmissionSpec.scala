@@ -181,7 +181,7 @@ class VerilogEmissionSpec extends AnyFlatSpec with Matchers {
       LaneEnables.mismatches(text) shouldBe empty
       LaneEnables.unguarded(text, m) shouldBe empty
       // What the miscompile looked like: lane 2's copy from the head chain under lane 1's head shift.
-      val broken = text.replaceFirst("if \\(headCopy_replica2\\)(\\s+window_2_box <=)", "if (headShift_replica1)$1")
+      val broken = text.replaceFirst("if \\(windowWrite_replica2\\)(\\s+window_2_box <=)", "if (headShift_replica1)$1")
       broken should not equal text
       LaneEnables.mismatches(broken) shouldBe Seq("window_2_box <=" -> "headShift_replica1")
       Files.writeString(dir.resolve("StreamEngine.sv"), broken)
