@@ -30,13 +30,19 @@ void setBox(VBroadPhaseAccel& top, const KeyBox& b) {
   top.io_load_bits_max_2 = b.max[2];
 }
 
-// Appends the pairs of the beat on the result port to `out`.
+// Appends the pairs of the beat on the result port to `out`. Bit k is the
+// pair (iBase + k, jBase + k), both modulo 2^BPACCEL_INDEX_WIDTH: a short
+// stream run's bases come moved down by its head pad and may wrap (its
+// lanes below the pad never hit, so the pairs themselves do not).
 void appendBeat(const VBroadPhaseAccel& top, std::vector<Pair>& out) {
+  static_assert(BPACCEL_INDEX_WIDTH >= 1 && BPACCEL_INDEX_WIDTH < 32, "indices fit a 32-bit word");
+  constexpr std::uint32_t indexMask = (1u << BPACCEL_INDEX_WIDTH) - 1;
   const std::uint32_t i0 = top.io_result_bits_iBase;
   const std::uint32_t j0 = top.io_result_bits_jBase;
   for (std::size_t k = 0; k < BPACCEL_M; ++k)
     if (maskBit(top.io_result_bits_mask, k))
-      out.emplace_back(i0 + static_cast<std::uint32_t>(k), j0 + static_cast<std::uint32_t>(k));
+      out.emplace_back((i0 + static_cast<std::uint32_t>(k)) & indexMask,
+                       (j0 + static_cast<std::uint32_t>(k)) & indexMask);
 }
 
 // Adds the hardware's counters of its last run or batch to `stats`.

@@ -31,6 +31,17 @@ case class BatchOutcome(
   driverCycles: Long // clock steps from the cycle that took the first count to the last busy one, both included
 )
 
+object AccelDriver {
+  /** The pairs of one result beat: bit k of `mask` is objects (iBase + k, jBase + k),
+    * both modulo 2^indexWidth (a short stream run's bases are moved down by its
+    * head pad and may wrap; see ScheduleBeat).
+    */
+  def beatPairs(p: AccelParams, iBase: Int, jBase: Int, mask: BigInt): Seq[(Int, Int)] = {
+    val wrap = (1 << p.indexWidth) - 1
+    (0 until p.m).filter(mask.testBit).map(k => ((iBase + k) & wrap, (jBase + k) & wrap))
+  }
+}
+
 /** Drives a [[BroadPhaseAccel]] through its ports, one clock at a time. */
 class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
   private val p = dut.p
@@ -99,7 +110,7 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
         val i0   = dut.io.result.bits.iBase.peek().litValue.toInt
         val j0   = dut.io.result.bits.jBase.peek().litValue.toInt
         val mask = dut.io.result.bits.mask.peek().litValue
-        for (k <- 0 until p.m if mask.testBit(k)) pairs += ((i0 + k, j0 + k))
+        pairs ++= AccelDriver.beatPairs(p, i0, j0, mask)
       }
       dut.io.debug.foreach { d =>
         if (d.cycleValid.peek().litToBoolean)
@@ -171,7 +182,7 @@ class AccelDriver(dut: BroadPhaseAccel, maxCyclesPerRun: Int = 200000) {
         val i0   = dut.io.result.bits.iBase.peek().litValue.toInt
         val j0   = dut.io.result.bits.jBase.peek().litValue.toInt
         val mask = dut.io.result.bits.mask.peek().litValue
-        for (k <- 0 until p.m if mask.testBit(k)) pairs += ((cell, i0 + k, j0 + k))
+        for ((i, j) <- AccelDriver.beatPairs(p, i0, j0, mask)) pairs += ((cell, i, j))
       }
       step()
       cycle += 1

@@ -254,8 +254,8 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
         if (dut.io.result.valid.peek().litToBoolean) {
           dut.io.result.bits.cell.expect(0.U)
           val mask = dut.io.result.bits.mask.peek().litValue
-          for (k <- 0 until p.m if mask.testBit(k))
-            pairs += ((dut.io.result.bits.iBase.peek().litValue.toInt + k, dut.io.result.bits.jBase.peek().litValue.toInt + k))
+          pairs ++= AccelDriver.beatPairs(p, dut.io.result.bits.iBase.peek().litValue.toInt,
+            dut.io.result.bits.jBase.peek().litValue.toInt, mask)
         }
         dut.clock.step(); cycles += 1
         if (cycles > 1000) fail("the batch did not end")
