@@ -11,7 +11,10 @@ class Aabb(keyWidth: Int) extends Bundle {
 
 /** What an engine produces each issued schedule cycle: all its hits.
   * Lane k set in `mask` means objects (iBase + k) and (jBase + k) overlap,
-  * with iBase + k < jBase + k always.
+  * both sums taken modulo 2^indexWidth, with iBase + k < jBase + k always.
+  * The modulo matters for the stream's short runs, whose objects start d
+  * lanes up: their bases are moved down by d and may wrap, so that the mask
+  * leaves unshifted; lanes below d never hit, so no set bit's index wraps.
   */
 class ScheduleBeat(p: AccelParams) extends Bundle {
   val iBase = UInt(p.indexWidth.W)
@@ -21,7 +24,8 @@ class ScheduleBeat(p: AccelParams) extends Bundle {
 
 /** One result beat: a schedule cycle with at least one hit, and the cell of
   * its batch it belongs to (index within the batch from 0, modulo
-  * 2^cellTagWidth; 0 for a single run). Indices are local to that cell.
+  * 2^cellTagWidth; 0 for a single run). Indices are local to that cell,
+  * and decoded modulo 2^indexWidth as in [[ScheduleBeat]].
   */
 class ResultBeat(p: AccelParams) extends ScheduleBeat(p) {
   val cell = UInt(p.cellTagWidth.W)
@@ -135,18 +139,6 @@ object Engine {
   val HitCountGroup = 8
   private def groupSizes(m: Int): Seq[Int] = (0 until m by HitCountGroup).map(g => (m - g).min(HitCountGroup))
 
-  /** `x` moved down by `by` * `unit` bits, zeros in at the top, as wide as `x`:
-    * one stage of fixed shifts per bit of `by` (firrtl2's formal backend
-    * rejects a dynamic shift by an amount wider than the value, as at m = 1).
-    */
-  def shiftDown(x: UInt, by: UInt, unit: Int = 1): UInt = {
-    val w = x.getWidth
-    by.asBools.zipWithIndex.foldLeft(x) { case (v, (bit, b)) =>
-      val step = unit << b
-      Mux(bit, if (step >= w) 0.U(w.W) else (v >> step).pad(w), v)
-    }
-  }
-
   /** One count per group of lanes, each as wide as its group needs. */
   def hitCounts(m: Int): MixedVec[UInt] = MixedVec(groupSizes(m).map(size => UInt(log2Ceil(size + 1).W)))
 
@@ -192,15 +184,14 @@ abstract class Engine(val p: AccelParams) extends Module {
 
   /** Drives the result and the debug probe from the pipeline's last stage.
     *
-    * `shiftDown`: lanes by which the hit and lane masks are moved towards
-    * lane 0 on their way out, so that bit k is the pair (iBase + k,
-    * jBase + k) when the engine's lanes hold the run's objects from a lane
-    * other than 0 (the stream's short runs); `probeI` and `probeJ` come
-    * aligned. The lanes shifted out never hit (masked). The shift sits after
-    * the AND stage's registers, where the mask's lanes converge on the
-    * result queue: in front of them it spanned the lane array and was
-    * stream m = 32's critical path (84.9 MHz, 9.2 ns of routing). The any
-    * flag and the group counts do not depend on it.
+    * The hit and lane masks go out by lane of the engine, with no logic
+    * between the AND stage's registers and the result queue: an engine
+    * whose lanes hold the run's objects from a lane d other than 0 (the
+    * stream's short runs) gives bases already moved down by d, modulo
+    * 2^indexWidth (see [[ScheduleBeat]]). Until this, `emit` shifted both
+    * masks down by d lanes here, one mux level per bit of d across all m
+    * lanes, and that shift was the FPGA's critical path (docs/fpga.md).
+    * Probe lane k is engine lane k, as the mask's bit k is.
     */
   protected def emit(
     valid: Bool,
@@ -209,11 +200,10 @@ abstract class Engine(val p: AccelParams) extends Module {
     laneMask: UInt,
     probeI: Vec[UInt],
     probeJ: Vec[UInt],
-    hits: HitSummary,
-    shiftDown: UInt = 0.U
+    hits: HitSummary
   ): Unit = {
-    val hitMask = Engine.shiftDown(hits.mask, if (p.has(Fault.ShortRunMaskNotAligned)) 0.U else shiftDown)
-    val lanes   = Engine.shiftDown(laneMask, shiftDown)
+    val hitMask = hits.mask
+    val lanes   = laneMask
     io.out.valid      := valid
     io.out.bits.iBase := iBase
     io.out.bits.jBase := jBase

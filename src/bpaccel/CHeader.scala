@@ -52,7 +52,11 @@ object CHeader {
        |
        |/* Result encoding: one beat per schedule cycle with at least one hit,
        | * fields {iBase, jBase, mask[M], cell}. Bit k of mask set means objects
-       | * iBase + k and jBase + k overlap, and iBase + k < jBase + k.
+       | * (iBase + k) mod 2^BPACCEL_INDEX_WIDTH and (jBase + k) mod
+       | * 2^BPACCEL_INDEX_WIDTH overlap, and the first is below the second.
+       | * Take the sums modulo 2^BPACCEL_INDEX_WIDTH: a stream run of fewer than
+       | * M + 2 objects reports its bases moved down by the lanes it starts up
+       | * (so the mask needs no shift) and they may wrap below 0.
        | * A run of n >= 2 objects with a consumer that never stalls takes
        | * startup(n) + issue_cycles(n) + BPACCEL_RUN_OVERHEAD_CYCLES cycles, where
        | * issue_cycles(n) = sum over b = 0 .. (n-2)/M of (n - 1 - b*M) and

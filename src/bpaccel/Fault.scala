@@ -39,8 +39,8 @@ object Fault {
   case object BatchLoadsInSeries extends Fault("the batch loads its next cell only after the last one ended")
   /** The stream's window and A block miss the head registers' copy in the cycle after a start, so a batch's next cell may write them first. */
   case object HeadCopiedLate extends Fault("the stream's window misses the head registers' copy in the cycle after a start")
-  /** A short stream run's hit mask is not moved down by the lanes its objects start up the head chain. */
-  case object ShortRunMaskNotAligned extends Fault("a short stream run's hit mask is not moved down to lane 0")
+  /** A short stream run's beat bases are not moved down by the lanes its objects start up the head chain. */
+  case object ShortRunBasesNotMoved extends Fault("a short stream run's beat bases are not moved down by the head pad")
 
   val all: Seq[Fault] = Seq(
     CreditOneTooMany,
@@ -58,6 +58,6 @@ object Fault {
     CellCounterSkipsShortCells,
     BatchLoadsInSeries,
     HeadCopiedLate,
-    ShortRunMaskNotAligned
+    ShortRunBasesNotMoved
   )
 }

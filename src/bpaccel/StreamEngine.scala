@@ -35,8 +35,12 @@ import chisel3.util._
   * up the chain (object j in lane j + d; d is the loader's head pad, read
   * with the start), and so in the window and the A block: a short run's
   * lanes k < d are masked, and its lane k compares objects k - d and
-  * k - d + s. The hit mask leaves the AND stage's register moved down
-  * by d lanes (Engine.emit), so the beats are the schedule's exactly.
+  * k - d + s. The mask leaves in the engine's lane order; the beat's bases
+  * are moved down instead, iBase = base - d and jBase = s - d modulo
+  * 2^indexWidth, so bit k is still the pair (iBase + k, jBase + k) taken
+  * modulo 2^indexWidth, and a set bit (k >= d) never wraps. That costs a
+  * subtract beside the control's registers, where a shift of the mask by
+  * d lanes on its way out was the FPGA's critical path (docs/fpga.md).
   * Runs of more than one block have n >= m + 2 objects, so d = 0 for them.
   *
   * Bipartite runs (split na > 0: only objects 0 .. na-1 against na .. n-1)
@@ -531,7 +535,6 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     val iBase    = UInt(p.indexWidth.W)
     val jBase    = UInt(p.indexWidth.W)
     val laneMask = UInt(m.W) // by lane of the engine (the run's lane k - headOffset)
-    val shift    = UInt(log2Ceil(p.headObjects + 1).W) // headOffset
     val probeI   = Vec(m, UInt(p.indexWidth.W)) // only with the debug port
     val probeJ   = Vec(m, UInt(p.indexWidth.W))
   }
@@ -551,17 +554,21 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
   // With a reset: the result queue's credits count these stages in flight.
   val laneIssue   = ShiftRegisters(issue, StreamEngine.LaneLag, false.B, true.B)
   val laneObjects = toLanes(laneHasObjects)
-  val laneOffset  = toLanes(headOffset)
   val meta = Wire(new Meta)
-  meta.iBase    := toLanes(base(p.indexWidth - 1, 0))
-  meta.jBase    := toLanes(s(p.indexWidth - 1, 0))
-  meta.shift    := laneOffset
+  // Lane k holds objects base + k - d and s + k - d: the beat's bases are
+  // moved down by d (modulo 2^indexWidth; lanes below d never compare, so
+  // no hit wraps), here in control time, from the control's registers, so
+  // that the mask needs no shift on its way out (see the class comment).
+  private def movedDown(x: UInt): UInt =
+    (if (p.has(Fault.ShortRunBasesNotMoved)) x else x - headOffset)(p.indexWidth - 1, 0)
+  meta.iBase    := toLanes(movedDown(base))
+  meta.jBase    := toLanes(movedDown(s))
   meta.laneMask := laneObjects & VecInit(window.map(_.inB)).asUInt
   if (p.debugPort) {
     // The objects each lane really holds, from the tags that travelled with
-    // the data, moved down by d lanes as the hit mask is.
-    meta.probeI := alignDown(a.map(_.tag), laneOffset)
-    meta.probeJ := alignDown(window.map(_.tag), laneOffset)
+    // the data, by lane of the engine as the hit mask is.
+    meta.probeI := VecInit(a.map(_.tag))
+    meta.probeJ := VecInit(window.map(_.tag))
   } else {
     meta.probeI := DontCare
     meta.probeJ := DontCare
@@ -594,17 +601,10 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
     stage
   }
 
-  /** Lane k + by of `lanes` in lane k (the debug port's probes only). */
-  private def alignDown(lanes: Seq[UInt], by: UInt): Vec[UInt] = {
-    val w       = lanes.head.getWidth
-    val shifted = Engine.shiftDown(Cat(lanes.reverse), by, unit = w)
-    VecInit(Seq.tabulate(m)(k => shifted(k * w + w - 1, k * w)))
-  }
-
   /** `x` as the lanes see it: [[StreamEngine.LaneLag]] cycles late (see [[replicatedEnable]]). */
   private def toLanes[T <: Data](x: T): T =
     (1 to StreamEngine.LaneLag).foldLeft(x) { (value, _) =>
-      val late = Reg(chiselTypeOf(value)) // RegNext would leave the width to inference, which shiftDown needs now
+      val late = Reg(chiselTypeOf(value)) // of the value's own type, its width not left to inference
       late := value
       late
     }
@@ -664,8 +664,7 @@ class StreamEngine(p: AccelParams) extends Engine(p) {
 
   val outValid =
     if (p.has(Fault.RepeatLastBeat)) atAnd.valid || (RegNext(atAnd.valid, false.B) && !atAnd.valid) else atAnd.valid
-  emit(outValid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, atAnd.bits.probeI, atAnd.bits.probeJ, hits,
-    shiftDown = atAnd.bits.shift)
+  emit(outValid, atAnd.bits.iBase, atAnd.bits.jBase, atAnd.bits.laneMask, atAnd.bits.probeI, atAnd.bits.probeJ, hits)
 }
 
 object StreamEngine {

@@ -10,13 +10,17 @@ sealed abstract class Property(val name: String)
 object Property {
   /** The result queue never holds more than its depth, and hands the consumer
     * exactly the beats that entered it, each once, in order, whatever `ready` does.
+    * The beat that enters is the one the lanes define (bases read off them),
+    * so this also checks the bases the design reports.
     */
   case object ExactlyOnce extends Property("exactly-once")
   /** `done` means every beat was taken and none will come; it stays until the next start. */
   case object Done extends Property("done")
   /** A start with an error (or fewer than two objects) ends at once with its code and no beat. */
   case object ErrorStart extends Property("error-start")
-  /** Each lane compares i < j < n (a bipartite run: i < na <= j), and the beats of a run are distinct pairs. */
+  /** Each lane compares i < j < n (a bipartite run: i < na <= j), and the beats of a run are distinct pairs
+    * (lane k of a beat on ((iBase + k) mod 2^indexWidth, (jBase + k) mod 2^indexWidth)).
+    */
   case object Lanes extends Property("lanes")
   /** A run tests n(n-1)/2 pairs, a bipartite one na(n-na) (with [[Lanes]]: all of them), and each hit bit is the overlap of boxes i and j. */
   case object Pairs extends Property("pairs")
@@ -91,10 +95,12 @@ class FormalHarness(p: AccelParams, properties: Set[Property] = Property.all.toS
     quietRun := !(startCode === AccelError.None && io.start.bits.count >= 2.U)
   }
 
-  // ---- the cycle's beat: (iBase, jBase) with lane k on (iBase + k, jBase + k) ----
+  // ---- the cycle's beat: (iBase, jBase) with lane k on (iBase + k, jBase + k), modulo 2^indexWidth ----
   // Read off the lowest lane that compares: in a bipartite run lane 0 may
   // not, and after the reader's jump it holds an object of A that does not
-  // follow the window's later lanes (the beat names the objects compared).
+  // follow the window's later lanes (the beat names the objects compared);
+  // in a stream run of fewer than m + 2 objects the lanes below the head
+  // pad do not either, and the bases wrap below 0 (l.i - k wraps in UInt).
   val anyValid = lanes.map(_.valid).reduce(_ || _)
   val iBase    = PriorityMux(lanes.map(_.valid), lanes.zipWithIndex.map { case (l, k) => l.i - k.U })
   val jBase    = PriorityMux(lanes.map(_.valid), lanes.zipWithIndex.map { case (l, k) => l.j - k.U })
@@ -148,18 +154,32 @@ class FormalHarness(p: AccelParams, properties: Set[Property] = Property.all.toS
       "lane k does not hold objects iBase + k and jBase + k")
   }
   check(Property.Lanes, !cycle || goodRun, "a schedule cycle outside a run")
-  check(Property.Lanes, !cycle || na =/= 0.U || lanes(0).valid, "a schedule cycle of a triangular run without lane 0")
-  // Beats (iBase, jBase) rise strictly, iBase a multiple of m: then pair (iBase + k, jBase + k)
-  // names its beat and lane, so no pair is tested twice.
+  // A triangular run compares in every cycle, from lane 0 when it has
+  // m + 2 objects or more; a shorter run's objects may start up the lanes.
+  val longRun = n >= (m + 2).U // more than one block is possible
+  check(Property.Lanes, !cycle || na =/= 0.U || Mux(longRun, lanes(0).valid, anyValid),
+    "a schedule cycle of a triangular run without lane 0 (n >= m + 2) or without any lane")
+  // No pair is tested twice: pair (i, j) of lane k names its beat and lane.
+  //  - A run of n >= m + 2 objects: iBase a multiple of m and i = iBase + k
+  //    without wrapping, so i names iBase and k.
+  //  - A shorter run has one block: every beat has the run's first iBase,
+  //    so i names k ((i - iBase) mod 2^w).
+  //  - Beats rise strictly in (iBase, (jBase - iBase) mod 2^w), and j - i is
+  //    that difference, so within one iBase it names the beat.
   val compares = cycle && anyValid
-  check(Property.Lanes, !compares || iBase % m.U === 0.U, "iBase is not a multiple of m")
+  val delta    = jBase - iBase // j - i of every lane, modulo 2^indexWidth
+  check(Property.Lanes, !(compares && longRun) || iBase % m.U === 0.U, "iBase is not a multiple of m")
+  for (lane <- lanes)
+    check(Property.Lanes, !(lane.valid && longRun) || lane.i >= iBase, "a lane's i wraps below iBase in a long run")
   val seen  = RegInit(false.B)
   val lastI = Reg(UInt(p.indexWidth.W))
-  val lastJ = Reg(UInt(p.indexWidth.W))
+  val lastD = Reg(UInt(p.indexWidth.W))
+  check(Property.Lanes, !(compares && seen && !longRun) || iBase === lastI,
+    "a run of fewer than m + 2 objects changes iBase: it has one block")
   check(Property.Lanes,
-    !(compares && seen) || iBase > lastI || (iBase === lastI && jBase > lastJ),
-    "a beat's (iBase, jBase) does not follow the previous one's: a pair may repeat")
-  when(compares) { seen := true.B; lastI := iBase; lastJ := jBase }
+    !(compares && seen) || iBase > lastI || (iBase === lastI && delta > lastD),
+    "a beat's (iBase, jBase - iBase) does not follow the previous one's: a pair may repeat")
+  when(compares) { seen := true.B; lastI := iBase; lastD := delta }
   when(io.start.fire) { seen := false.B }
 
   // ---- pairs: all n(n-1)/2 tested (bipartite: na(n-na)), each hit bit right ----

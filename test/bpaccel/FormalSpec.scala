@@ -160,7 +160,7 @@ class FormalSpec extends AnyFlatSpec with ChiselScalatestTester with Formal with
     (Fault.LaneMaskOneTooWide, Property.Lanes, 2, 3, 16),
     (Fault.SkipSecondBlockAtMPlus2, Property.Pairs, 1, 3, 16),
     (Fault.HeadCopyOffByOne, Property.Lanes, 2, 3, 12),
-    (Fault.ShortRunMaskNotAligned, Property.Pairs, 2, 3, 12),
+    (Fault.ShortRunBasesNotMoved, Property.ExactlyOnce, 2, 3, 12),
     (Fault.BipartiteALanesUnmasked, Property.Lanes, 2, 3, 14)
   )
   private val longMutants: Seq[(Fault, Property, Int, Int, Int)] = Seq(
