@@ -1,6 +1,7 @@
 #include "broad_phase.hpp"
 
 #include <algorithm>
+#include <array>
 #include <future>
 #include <numeric>
 #include <stdexcept>
@@ -12,6 +13,7 @@
 
 #include "async_backend.hpp"
 #include "keys.hpp"
+#include "serial_stage.hpp"
 
 namespace bpaccel {
 namespace {
@@ -37,8 +39,12 @@ struct BroadPhase::Worker {
   unsigned keyWidth = 32;
   bool narrows() const { return keyWidth < 32; }
   std::vector<KeyBox> narrowedRun;  // runNow's narrowed cell
-  // The device's thread is stopped (after its last batch) before the buffers it reads go.
-  ~Worker() { async.reset(); }
+  // The decoder's and the device's threads are stopped (after their last
+  // batch) before the buffers they use go.
+  ~Worker() {
+    decoder.reset();
+    async.reset();
+  }
   std::vector<KeyBox> gathered;         // a chunk pair's boxes, packed for the backend
   std::vector<Pair> local;              // pairs of one hand-over, indices local to each cell
   std::vector<Pair> out;                // this worker's share of the frame's pairs
@@ -83,10 +89,20 @@ struct BroadPhase::Worker {
       boxes.clear();
     }
   };
-  Batch filling;   // the batch being filled
-  Batch inFlight;  // asynchronous only: the batch the device has, until its pairs are decoded
-  std::future<BatchResult> inFlightResult;
-  RunRecord inFlightRecord;
+  Batch filling;  // the batch being filled
+  // Asynchronous only: the batches handed over and not yet decoded, each
+  // with its answer to come and its record, used in turn; and the decoder
+  // thread, which waits for each answer and decodes it while the producer
+  // goes on. A slot is free again once the decoder has room for one more
+  // (its tasks run in hand-over order).
+  struct HandedOver {
+    Batch batch;
+    std::future<BatchResult> result;
+    RunRecord record;
+  };
+  std::array<HandedOver, kBatchesInFlight> handedOver;
+  std::size_t handOversThisFrame = 0;
+  std::unique_ptr<SerialStage> decoder;
   std::vector<std::size_t> cellEnds;
   static constexpr std::size_t kSizeBuckets = 256;
   std::vector<std::uint32_t> bucketStarts;  // flush's counting sort of a batch's cells by size
@@ -104,8 +120,8 @@ struct BroadPhase::Worker {
               std::span<const std::uint8_t> below, const Cell* region, std::size_t splitAt, int keep,
               std::size_t deviceSplit);
   void flush();   // hands the batch being filled over, if any
-  void finish();  // flush, then (asynchronous) wait for the batch in flight and decode it
-  void collect(); // asynchronous: waits for the batch in flight and decodes it
+  void finish();  // flush, then (asynchronous) wait until every batch handed over is decoded
+  void handOverAsynchronously(std::span<const std::span<const KeyBox>> toDevice);
   void startFrame(Clock::time_point start);
   // Appends a batch's kept pairs, given the backend's pairs and cell ends for it.
   void decodeBatch(const Batch& batch, std::span<const Pair> pairs, std::span<const std::size_t> ends);
@@ -181,6 +197,7 @@ BroadPhase::BroadPhase(const BackendFactory& makeBackend, std::optional<std::siz
         if (!device) throw std::invalid_argument("broad phase: the backend factory gave no backend");
         return device;
       });
+      w->decoder = std::make_unique<SerialStage>(kBatchesInFlight);
     } else {
       w->owned = makeBackend();
       if (!w->owned) throw std::invalid_argument("broad phase: the backend factory gave no backend");
@@ -333,17 +350,23 @@ void BroadPhase::startCells(Clock::time_point frameStart) {
 }
 
 void BroadPhase::Worker::startFrame(Clock::time_point start) {
+  // Left over only if a frame failed before its end: the device and the
+  // decoder must be done with those batches first (before `out` is cleared,
+  // which the decoder writes). Their failure was the failed frame's.
+  if (decoder) {
+    try {
+      decoder->drain();
+    } catch (...) {
+    }
+  }
+  handOversThisFrame = 0;
+  filling.clear();
   out.clear();
   stats = {};
   backendSeconds = 0;
   frameStart = start;
   runs.clear();
   batchLimit = firstBatchCells;
-  // Left over only if a frame failed: the device must be done with it first.
-  if (inFlightResult.valid()) inFlightResult.wait();
-  filling.clear();
-  inFlight.clear();
-  inFlightResult = {};
 }
 
 void BroadPhase::finishCells(std::vector<Pair>& out) {
@@ -481,50 +504,48 @@ void BroadPhase::Worker::flush() {
     filling.clear();
     return;
   }
-  // Asynchronous: this batch goes to the device, then the one before it is
-  // decoded while the device runs this one; this batch's buffers then wait
-  // in `inFlight` (swapping vectors keeps their storage, so the spans the
-  // device holds stay valid) and `filling` takes the decoded one's storage.
-  RunRecord record;
-  record.readySeconds = seconds(frameStart, Clock::now()) - backendSeconds;
-  std::future<BatchResult> result = async->submit(toDevice, filling.splits);
-  try {
-    collect();
-  } catch (...) {
-    result.wait();  // the device must be done with this batch's buffers before they are reused
+  handOverAsynchronously(toDevice);
+}
+
+// The batch goes to the device and its decoding to the decoder thread, which
+// waits for the device's answer; the producer goes on filling the next batch
+// at once. With kBatchesInFlight batches handed over and not yet decoded, it
+// waits for the oldest to be decoded, whose slot (and storage) this batch
+// takes: time waiting for the device, not host work.
+void BroadPhase::Worker::handOverAsynchronously(std::span<const std::span<const KeyBox>> toDevice) {
+  if (decoder->failed()) {
     filling.clear();
-    throw;
+    decoder->drain();  // rethrows the device's or the decoding's failure: the frame stops here
   }
-  std::swap(filling, inFlight);
-  inFlightResult = std::move(result);
-  inFlightRecord = record;
+  const auto ready = Clock::now();
+  RunRecord record;
+  record.readySeconds = seconds(frameStart, ready) - backendSeconds;
+  decoder->waitForRoom();
+  backendSeconds += seconds(ready, Clock::now());
+  HandedOver& slot = handedOver[handOversThisFrame++ % kBatchesInFlight];
+  slot.result = async->submit(toDevice, filling.splits);
+  // Swapping keeps the vectors' storage, so the spans the device holds stay
+  // valid; `filling` takes the decoded batch's storage.
+  std::swap(filling, slot.batch);
   filling.clear();
+  slot.record = record;
+  decoder->post([this, &slot] {
+    BatchResult result = slot.result.get();  // rethrows the device's failure
+    const auto got = Clock::now();
+    stats += result.stats;
+    decodeBatch(slot.batch, result.pairs, result.cellEnds);
+    slot.record.stats = result.stats;
+    slot.record.decodeSeconds = seconds(got, Clock::now());
+    runs.push_back(slot.record);
+  });
 }
 
 void BroadPhase::Worker::finish() {
   flush();
-  if (async) collect();
-}
-
-void BroadPhase::Worker::collect() {
-  if (!inFlightResult.valid()) return;
+  if (!decoder) return;
   const auto waitFrom = Clock::now();
-  BatchResult result;
-  try {
-    result = inFlightResult.get();  // rethrows the device's failure
-  } catch (...) {
-    inFlight.clear();
-    throw;
-  }
-  const auto got = Clock::now();
-  backendSeconds += seconds(waitFrom, got);  // the host waited for the device: not host work
-  RunRecord record = inFlightRecord;
-  record.stats = result.stats;
-  stats += result.stats;
-  decodeBatch(inFlight, result.pairs, result.cellEnds);
-  record.decodeSeconds = seconds(got, Clock::now());
-  runs.push_back(record);
-  inFlight.clear();
+  decoder->drain();  // every batch decoded; rethrows the first failure
+  backendSeconds += seconds(waitFrom, Clock::now());
 }
 
 void BroadPhase::Worker::decodeBatch(const Batch& batch, std::span<const Pair> pairs,

@@ -29,11 +29,15 @@ struct HostTimes {
 };
 
 /// How a worker hands its batches to the backend: waiting for each
-/// (Synchronous), or through an AsyncBackend that builds the worker's backend
-/// on a thread of its own, so that the next batch fills while the device
-/// runs the last one, whose pairs are decoded once the next has gone
-/// (Asynchronous; only with the factory constructor and cellsPerBatch > 1).
-/// The pairs, the counters and the hand-overs are the same either way.
+/// (Synchronous), or as a pipeline of three threads (Asynchronous; only
+/// with the factory constructor and cellsPerBatch > 1): the worker's
+/// thread fills batches and hands each over to an AsyncBackend, which runs
+/// the worker's backend on a thread of its own, and goes on at once; a
+/// decoder thread (SerialStage) waits for each batch's answer and decodes
+/// it. At most kBatchesInFlight batches are handed over and not yet
+/// decoded; the worker waits for the oldest before it hands over one more.
+/// This is the schedule modelPipeline models. The pairs (in the same order),
+/// the counters and the hand-overs are the same either way.
 enum class HandOvers { Synchronous, Asynchronous };
 
 /// Finds every overlapping pair of a scene exactly once. Without a cell size

@@ -19,6 +19,11 @@ struct RunRecord {
   RunStats stats;  // this run's counters (cycles from rtl or model)
 };
 
+/// Hand-overs the asynchronous host keeps handed over and not yet decoded
+/// (BroadPhase, HandOvers::Asynchronous): with that many out, the producer
+/// waits for the oldest to be decoded before it hands over the next.
+inline constexpr std::size_t kBatchesInFlight = 3;
+
 /// What the device and the link are modelled with.
 struct PipelineModel {
   double clockHz = 100e6;
@@ -26,6 +31,7 @@ struct PipelineModel {
   double latencySeconds = 1e-6;  // each way: a command reaches the device, a completion the host
   double bytesPerBox = 24;
   double bytesPerBeat = 4;
+  std::size_t batchesInFlight = kBatchesInFlight;  // the host's bound (at least 1)
 };
 
 /// An interval of one lane of the timeline, for the plot.
@@ -34,9 +40,14 @@ struct Span {
   std::size_t run = 0;
 };
 
-/// A frame's timeline. The host is two threads: one produces runs (keys,
-/// tree, packing), as measured but without the decoding the serial run did
-/// in between; one decodes each run's results once they have arrived.
+/// A frame's timeline, as BroadPhase's asynchronous hand-overs
+/// (HandOvers::Asynchronous) run it, built from a synchronous run's measured
+/// parts. The host is two threads: the producer makes runs (keys, partition,
+/// packing), as measured but without the decoding the synchronous run did in
+/// between, and hands each over; the decoder decodes each run's results, in
+/// order, once they have arrived. With batchesInFlight runs handed over and
+/// not yet decoded, the producer waits for the oldest one's decoding before
+/// it hands over the next (and all its later work moves by that wait).
 /// A run waits for the device and the link to be free: its boxes stream in
 /// through the load port, as fast as the slower of the link and the port
 /// (one box a cycle), the device computes, result beats return over the

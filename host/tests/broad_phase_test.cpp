@@ -349,11 +349,44 @@ TEST(ModelPipeline, OverlapsHostLinkAndDeviceAsWorkedOutByHand) {
   EXPECT_NEAR(t.frameSeconds, 51e-6, 1e-12);
 }
 
+TEST(ModelPipeline, HoldsTheProducerBackWhileItsBatchesInFlightAreUndecoded) {
+  // The hand-worked case above, with room for one batch only: the second is
+  // ready at 10 us but its batch is free once the first is decoded, at 37.
+  PipelineModel model{1e6, 24e6, 0, 24, 24};
+  EXPECT_EQ(model.batchesInFlight, kBatchesInFlight);  // the host's own bound by default
+  model.batchesInFlight = 1;
+  RunRecord first, second;
+  first.readySeconds = 10e-6;
+  first.decodeSeconds = 2e-6;
+  first.stats.boxesSent = 4;
+  first.stats.loadCycles = 5;
+  first.stats.cycles = 20;
+  first.stats.beatsReceived = 3;
+  second.readySeconds = 12e-6;
+  second.decodeSeconds = 1e-6;
+  second.stats.boxesSent = 2;
+  second.stats.loadCycles = 3;
+  second.stats.cycles = 10;
+  const auto t = modelPipeline({first, second}, 15e-6, model);
+  EXPECT_NEAR(t.decode[0].end, 37e-6, 1e-12);
+  EXPECT_NEAR(t.device[1].start, 37e-6, 1e-12);  // not 35, when the device was free
+  EXPECT_NEAR(t.decode[1].end, 51e-6, 1e-12);
+  // The producer's 27 us wait moves the rest of its work too: 15 - 3 of decoding + 27.
+  EXPECT_NEAR(t.producerSeconds, 39e-6, 1e-12);
+  EXPECT_NEAR(t.frameSeconds, 51e-6, 1e-12);
+  // Two in flight: no wait, the worked case's 49 us.
+  model.batchesInFlight = 2;
+  EXPECT_NEAR(modelPipeline({first, second}, 15e-6, model).frameSeconds, 49e-6, 1e-12);
+  model.batchesInFlight = 0;
+  EXPECT_THROW(modelPipeline({first, second}, 15e-6, model), std::invalid_argument);
+}
+
 TEST(ModelPipeline, NeverBeatsTheBusiestLaneNorLosesToTheSerialSum) {
   std::mt19937 rng(8);
   std::uniform_real_distribution<double> us(0, 5e-6);
-  const PipelineModel model{100e6, 4e9, 1e-6, 24, 4};
+  PipelineModel model{100e6, 4e9, 1e-6, 24, 4};
   for (int trial = 0; trial < 200; ++trial) {
+    model.batchesInFlight = 1 + trial % 4;  // however few batches the host may have out
     std::vector<RunRecord> runs(1 + rng() % 30);
     double ready = 0, host = 0, device = 0, serial = 0;
     for (auto& r : runs) {

@@ -1,0 +1,54 @@
+#pragma once
+// One stage of a pipeline on a thread of its own: tasks run one after the
+// other, in the order they were posted, while the poster goes on.
+
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <exception>
+#include <functional>
+#include <mutex>
+#include <stop_token>
+#include <thread>
+
+namespace bpaccel {
+
+/// Runs posted tasks in order on one thread. At most `maxPending` tasks are
+/// outstanding (posted, not yet finished): waitForRoom() blocks until one more
+/// may be posted, so a poster that recycles a fixed set of buffers knows the
+/// oldest one is free again. A task that throws does not stop the stage: the
+/// first exception is kept and rethrown by drain(), and the tasks after it
+/// still run (each may own a resource that must be released).
+class SerialStage {
+ public:
+  explicit SerialStage(std::size_t maxPending);
+  /// Runs every task posted before it, then stops the thread.
+  ~SerialStage();
+  SerialStage(const SerialStage&) = delete;
+  SerialStage& operator=(const SerialStage&) = delete;
+
+  std::size_t maxPending() const { return maxPending_; }
+  /// Blocks until fewer than maxPending tasks are outstanding.
+  void waitForRoom();
+  /// Queues `task`; blocks first, as waitForRoom, if the stage is full.
+  void post(std::function<void()> task);
+  /// Blocks until every posted task has finished; then rethrows (and forgets)
+  /// the first exception a task threw since the last drain.
+  void drain();
+  /// Whether a task has thrown since the last drain (the poster may stop early).
+  bool failed();
+
+ private:
+  void serve(std::stop_token stop);
+
+  std::size_t maxPending_;
+  std::mutex mutex_;
+  std::condition_variable_any taskReady_;  // the stage's thread waits here
+  std::condition_variable finished_;       // posters wait here for room, or for the end
+  std::deque<std::function<void()>> tasks_;
+  std::size_t outstanding_ = 0;  // queued or running
+  std::exception_ptr firstFailure_;
+  std::jthread thread_;  // last: it starts once the members it uses exist, and stops first
+};
+
+}  // namespace bpaccel
