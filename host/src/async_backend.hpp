@@ -2,20 +2,16 @@
 // A backend on a thread of its own: hand-overs are submitted, and their
 // results collected later while the caller goes on.
 
-#include <condition_variable>
 #include <cstddef>
-#include <deque>
 #include <functional>
 #include <future>
 #include <memory>
-#include <mutex>
 #include <span>
-#include <stop_token>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "backend.hpp"
+#include "serial_stage.hpp"
 
 namespace bpaccel {
 
@@ -56,22 +52,12 @@ class AsyncBackend {
                                   std::span<const std::size_t> splits = {});
 
  private:
-  struct Job {
-    std::vector<std::span<const KeyBox>> cells;
-    std::vector<std::size_t> splits;
-    std::promise<BatchResult> result;
-  };
-  std::future<BatchResult> enqueue(Job job);
-  void serve(std::stop_token stop, Backend& device);
-
+  std::unique_ptr<Backend> device_;  // built, used and destroyed on the stage's thread only
   std::string name_;
   std::size_t capacity_ = 0;
   bool bipartite_ = false;
   unsigned keyWidth_ = 32;
-  std::mutex mutex_;
-  std::condition_variable_any jobReady_;
-  std::deque<Job> jobs_;
-  std::jthread worker_;  // last: it starts once the members it uses exist, and stops first
+  SerialStage stage_;  // last: its thread stops first, after the hand-overs queued
 };
 
 }  // namespace bpaccel
