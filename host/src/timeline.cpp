@@ -5,6 +5,18 @@
 
 namespace bpaccel {
 
+HandOverTimes handOverTimes(const RunStats& s, const PipelineModel& model) {
+  HandOverTimes t;
+  t.boxesSeconds = model.bytesPerBox * static_cast<double>(s.boxesSent) / model.bandwidthBytesPerSecond;
+  // The port takes one box a cycle, partly under runs (overlapped loads);
+  // a link slower than that adds its shortfall in full.
+  const double port = static_cast<double>(s.boxesSent) / model.clockHz;
+  t.loadSeconds = static_cast<double>(s.loadCycles) / model.clockHz + std::max(0.0, t.boxesSeconds - port);
+  t.computeSeconds = static_cast<double>(s.cycles) / model.clockHz;
+  t.resultsSeconds = model.bytesPerBeat * static_cast<double>(s.beatsReceived) / model.bandwidthBytesPerSecond;
+  return t;
+}
+
 FrameTimeline modelPipeline(const std::vector<RunRecord>& runs, double hostSeconds, const PipelineModel& model) {
   if (!(model.clockHz > 0) || !(model.bandwidthBytesPerSecond > 0) || model.latencySeconds < 0)
     throw std::invalid_argument("pipeline model: clock and bandwidth must be positive, latency not negative");
@@ -30,13 +42,7 @@ FrameTimeline modelPipeline(const std::vector<RunRecord>& runs, double hostSecon
     t.produce.push_back({produceStart, ready, i});
     produceStart = ready;
 
-    const double boxes = model.bytesPerBox * static_cast<double>(s.boxesSent) / model.bandwidthBytesPerSecond;
-    // The port takes one box a cycle, partly under runs (overlapped loads);
-    // a link slower than that adds its shortfall in full.
-    const double port = static_cast<double>(s.boxesSent) / model.clockHz;
-    const double load = static_cast<double>(s.loadCycles) / model.clockHz + std::max(0.0, boxes - port);
-    const double compute = static_cast<double>(s.cycles) / model.clockHz;
-    const double results = model.bytesPerBeat * static_cast<double>(s.beatsReceived) / model.bandwidthBytesPerSecond;
+    const auto [boxes, load, compute, results] = handOverTimes(s, model);
     const double start = std::max({ready + model.latencySeconds, linkFree, deviceFree});
     t.link.push_back({start, start + boxes, i});
     if (results > 0) t.link.push_back({start + load, start + load + results, i});

@@ -34,6 +34,15 @@ struct PipelineModel {
   std::size_t batchesInFlight = kBatchesInFlight;  // the host's bound (at least 1)
 };
 
+/// One hand-over's modelled parts, from its counters.
+struct HandOverTimes {
+  double boxesSeconds = 0;    // its boxes on the link
+  double loadSeconds = 0;     // the load port's busy cycles, and a slower link's shortfall
+  double computeSeconds = 0;  // the device's run cycles
+  double resultsSeconds = 0;  // its result beats on the link
+};
+HandOverTimes handOverTimes(const RunStats& stats, const PipelineModel& model);
+
 /// An interval of one lane of the timeline, for the plot.
 struct Span {
   double start = 0, end = 0;

@@ -13,6 +13,13 @@
 // buffer larger than the caches before each frame, as the benchmark's other
 // methods do between two frames of this one.
 //
+// --paced also runs each configuration's asynchronous hand-overs
+// (HandOvers::Asynchronous: the producer, the device's thread and the decoder
+// thread) against a device held for its modelled time (PacedDevice), and
+// prints that frame's measured wall time beside the modelled overlapped
+// frame: a check of the model against the threads that run it. The device
+// is still the model backend; only its duration is emulated.
+//
 // Several --first-batch-cells values are timed side by side: every frame runs
 // each configuration in turn (in a rotating order), so that the machine's
 // drift over a run falls on all of them alike. Each also prints the MODELLED
@@ -24,7 +31,10 @@
 #include <cstdlib>
 #include <new>
 #include <memory>
+#include <thread>
 #include <vector>
+
+#include <sys/prctl.h>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -58,6 +68,55 @@ double median(std::vector<double> v) {
   return (v[(v.size() - 1) / 2] + v[v.size() / 2]) / 2;
 }
 
+// A device that takes its modelled time: the wrapped backend's pairs and
+// counters, returned once a command's latency, the load, the run (or the
+// results on the link, if longer) and a completion's latency have passed
+// since the hand-over reached the device (handOverTimes, the model's own
+// parts). It holds the device through the completion's latency, which the
+// model overlaps with the next hand-over: 1 us a hand-over more than the model.
+class PacedDevice final : public bpaccel::Backend {
+ public:
+  PacedDevice(std::unique_ptr<bpaccel::Backend> inner, const bpaccel::PipelineModel& model,
+              std::vector<double>& lateSeconds)
+      : inner_(std::move(inner)), model_(model), late_(lateSeconds) {
+    prctl(PR_SET_TIMERSLACK, 1UL);  // this thread's sleeps end on time, not up to 50 us late
+  }
+  std::string name() const override { return "paced " + inner_->name(); }
+  std::size_t capacity() const override { return inner_->capacity(); }
+  unsigned keyWidth() const override { return inner_->keyWidth(); }
+  bool bipartite() const override { return inner_->bipartite(); }
+  void run(std::span<const bpaccel::KeyBox> boxes, std::vector<bpaccel::Pair>& out, bpaccel::RunStats& stats) override {
+    paced(stats, [&](bpaccel::RunStats& s) { inner_->run(boxes, out, s); });
+  }
+  void runBipartite(std::span<const bpaccel::KeyBox> boxes, std::size_t split, std::vector<bpaccel::Pair>& out,
+                    bpaccel::RunStats& stats) override {
+    paced(stats, [&](bpaccel::RunStats& s) { inner_->runBipartite(boxes, split, out, s); });
+  }
+  void runBatch(std::span<const std::span<const bpaccel::KeyBox>> cells, std::span<const std::size_t> splits,
+                std::vector<bpaccel::Pair>& out, std::vector<std::size_t>& cellEnds,
+                bpaccel::RunStats& stats) override {
+    paced(stats, [&](bpaccel::RunStats& s) { inner_->runBatch(cells, splits, out, cellEnds, s); });
+  }
+
+ private:
+  template <typename Run>
+  void paced(bpaccel::RunStats& stats, Run&& run) {
+    const auto reached = Clock::now();
+    bpaccel::RunStats mine;
+    run(mine);
+    stats += mine;
+    const auto t = bpaccel::handOverTimes(mine, model_);
+    const double hold = 2 * model_.latencySeconds + t.loadSeconds + std::max(t.computeSeconds, t.resultsSeconds);
+    const auto until = reached + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(hold));
+    std::this_thread::sleep_until(until);
+    late_.push_back(std::chrono::duration<double>(Clock::now() - until).count());
+  }
+
+  std::unique_ptr<bpaccel::Backend> inner_;
+  bpaccel::PipelineModel model_;
+  std::vector<double>& late_;  // per hand-over: how late the device answered (read once a frame has ended)
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -83,6 +142,9 @@ int main(int argc, char** argv) {
   app.add_option("--passes", passes, "Passes over the recorded frames")->capture_default_str()
       ->check(CLI::PositiveNumber);
   app.add_flag("--evict", evict, "Evict the caches before each frame");
+  bool paced = false;
+  app.add_flag("--paced", paced,
+               "Also run the asynchronous hand-overs against a device held for its modelled time, and time them");
   app.add_option("--key-width", keyWidths,
                  "Key widths of the model's device (default: the built hardware's); several: compared. "
                  "Below 32 the host narrows each cell's keys and checks the pairs")
@@ -122,7 +184,18 @@ int main(int argc, char** argv) {
     std::vector<double> host, convert, part, cells, decode, pipelined;
     std::vector<double> allocations;  // after the first pass
     unsigned keyWidth = 32;
+    // --paced: the same configuration's asynchronous hand-overs on a paced device.
+    std::unique_ptr<bpaccel::BroadPhase> pacedPhase;
+    std::unique_ptr<std::vector<double>> late = std::make_unique<std::vector<double>>();
+    std::vector<double> pacedWall;
   };
+  bpaccel::PipelineModel model;  // the benchmark's link model (--link-gbytes-per-s 4, --link-latency-us 1)
+  model.clockHz = clockMHz * 1e6;
+  model.bytesPerBeat = static_cast<double>(bpaccel::resultBeatBytesOfBuiltHardware());
+  if (paced && (backendName != "model" || cellsPerBatch < 2)) {
+    fmt::print(stderr, "frame_timing: --paced needs --backend model and --cells-per-batch of at least 2\n");
+    return 2;
+  }
   std::vector<Timed> timed;
   for (const std::size_t first : firstBatchCells)
     for (const unsigned keyWidth : keyWidths) {
@@ -132,11 +205,18 @@ int main(int argc, char** argv) {
       t.phase = std::make_unique<bpaccel::BroadPhase>(*t.backend, cellSize, cellsPerBatch,
                                                       bpaccel::parsePartitionKind(partition));
       t.phase->setFirstBatchCells(first);
+      if (paced) {
+        bpaccel::PipelineModel deviceModel = model;
+        deviceModel.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(keyWidth));
+        t.pacedPhase = std::make_unique<bpaccel::BroadPhase>(
+            [&makeBackend, keyWidth, deviceModel, late = t.late.get()] {
+              return std::make_unique<PacedDevice>(makeBackend(keyWidth), deviceModel, *late);
+            },
+            cellSize, 1, cellsPerBatch, bpaccel::parsePartitionKind(partition), bpaccel::HandOvers::Asynchronous);
+        t.pacedPhase->setFirstBatchCells(first);
+      }
       timed.push_back(std::move(t));
     }
-  bpaccel::PipelineModel model;  // the benchmark's link model (--link-gbytes-per-s 4, --link-latency-us 1)
-  model.clockHz = clockMHz * 1e6;
-  model.bytesPerBeat = static_cast<double>(bpaccel::resultBeatBytesOfBuiltHardware());
 
   std::vector<char> flood(evict ? 64u << 20 : 0);
   std::vector<bpaccel::Pair> pairs;
@@ -170,6 +250,18 @@ int main(int argc, char** argv) {
                      exact[f].size());
           return 1;
         }
+        if (t.pacedPhase) {
+          for (std::size_t b = 0; b < flood.size(); b += 64) sink += static_cast<unsigned char>(++flood[b]);
+          const auto p0 = Clock::now();
+          t.pacedPhase->findPairs(recorded[f], pairs);
+          t.pacedWall.push_back(std::chrono::duration<double>(Clock::now() - p0).count());
+          std::sort(pairs.begin(), pairs.end());
+          if (pairs != exact[f]) {
+            fmt::print(stderr, "frame_timing: paced frame {} pass {}: {} pairs, the exact set has {}\n", f, p,
+                       pairs.size(), exact[f].size());
+            return 1;
+          }
+        }
       }
     }
   }
@@ -186,6 +278,15 @@ int main(int argc, char** argv) {
                t.keyWidth, t.phase->firstBatchCells(), us(t.host), us(t.convert), us(t.part), us(t.cells), us(t.decode),
                us(t.pipelined), clockMHz, pairs.size(), stats.hits, stats.runs, stats.batches, stats.deviceCycles(),
                median(t.allocations));
+    if (t.pacedPhase) {
+      std::vector<double> ratio;
+      for (std::size_t i = 0; i < t.pacedWall.size(); ++i) ratio.push_back(t.pacedWall[i] / t.pipelined[i]);
+      fmt::print("  paced: asynchronous hand-overs against a device held for its modelled time: frame_us {:.1f} "
+                 "(measured wall time; device emulated), per frame {:.3f}x the modelled overlapped frame; "
+                 "the device answered a median {:.1f} us late (max {:.1f}) over {} hand-overs\n",
+                 us(t.pacedWall), median(ratio), us(*t.late),
+                 t.late->empty() ? 0.0 : *std::max_element(t.late->begin(), t.late->end()) * 1e6, t.late->size());
+    }
     if (k > 0) {  // paired with the first configuration, frame by frame
       std::vector<double> ratio;
       for (std::size_t i = 0; i < t.pipelined.size(); ++i) ratio.push_back(t.pipelined[i] / timed[0].pipelined[i]);
