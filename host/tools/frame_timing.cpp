@@ -17,8 +17,9 @@
 // (HandOvers::Asynchronous: the producer, the device's thread and the decoder
 // thread) against a device held for its modelled time (PacedDevice), and
 // prints that frame's measured wall time beside the modelled overlapped
-// frame: a check of the model against the threads that run it. The device
-// is still the model backend; only its duration is emulated.
+// frame: a check of the model against the threads that run it. The paced
+// device replays the model backend's answers recorded in the synchronous
+// run of the same frame; only its duration is emulated.
 //
 // Several --first-batch-cells values are timed side by side: every frame runs
 // each configuration in turn (in a rotating order), so that the machine's
@@ -31,6 +32,7 @@
 #include <cstdlib>
 #include <new>
 #include <memory>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -39,6 +41,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "async_backend.hpp"
 #include "backend.hpp"
 #include "broad_phase.hpp"
 #include "exact_pairs.hpp"
@@ -68,53 +71,95 @@ double median(std::vector<double> v) {
   return (v[(v.size() - 1) / 2] + v[v.size() / 2]) / 2;
 }
 
-// A device that takes its modelled time: the wrapped backend's pairs and
-// counters, returned once a command's latency, the load, the run (or the
-// results on the link, if longer) and a completion's latency have passed
-// since the hand-over reached the device (handOverTimes, the model's own
-// parts). It holds the device through the completion's latency, which the
-// model overlaps with the next hand-over: 1 us a hand-over more than the model.
-class PacedDevice final : public bpaccel::Backend {
+// Each hand-over's answer, recorded from the synchronous run of a frame and
+// replayed in the same order by the paced run of the same frame (the
+// asynchronous hand-overs are the synchronous ones: the tests prove it).
+using Recording = std::vector<bpaccel::BatchResult>;
+
+// The synchronous run's device: the model backend, its answers recorded.
+class RecordingDevice final : public bpaccel::Backend {
  public:
-  PacedDevice(std::unique_ptr<bpaccel::Backend> inner, const bpaccel::PipelineModel& model,
-              std::vector<double>& lateSeconds)
-      : inner_(std::move(inner)), model_(model), late_(lateSeconds) {
-    prctl(PR_SET_TIMERSLACK, 1UL);  // this thread's sleeps end on time, not up to 50 us late
-  }
-  std::string name() const override { return "paced " + inner_->name(); }
+  RecordingDevice(std::unique_ptr<bpaccel::Backend> inner, Recording& recording)
+      : inner_(std::move(inner)), recording_(recording) {}
+  std::string name() const override { return inner_->name(); }
   std::size_t capacity() const override { return inner_->capacity(); }
   unsigned keyWidth() const override { return inner_->keyWidth(); }
   bool bipartite() const override { return inner_->bipartite(); }
-  void run(std::span<const bpaccel::KeyBox> boxes, std::vector<bpaccel::Pair>& out, bpaccel::RunStats& stats) override {
-    paced(stats, [&](bpaccel::RunStats& s) { inner_->run(boxes, out, s); });
-  }
-  void runBipartite(std::span<const bpaccel::KeyBox> boxes, std::size_t split, std::vector<bpaccel::Pair>& out,
-                    bpaccel::RunStats& stats) override {
-    paced(stats, [&](bpaccel::RunStats& s) { inner_->runBipartite(boxes, split, out, s); });
+  void run(std::span<const bpaccel::KeyBox>, std::vector<bpaccel::Pair>&, bpaccel::RunStats&) override {
+    throw std::logic_error("frame_timing: the recorded device takes batches only");
   }
   void runBatch(std::span<const std::span<const bpaccel::KeyBox>> cells, std::span<const std::size_t> splits,
                 std::vector<bpaccel::Pair>& out, std::vector<std::size_t>& cellEnds,
                 bpaccel::RunStats& stats) override {
-    paced(stats, [&](bpaccel::RunStats& s) { inner_->runBatch(cells, splits, out, cellEnds, s); });
+    bpaccel::BatchResult r;  // this hand-over's own: its cell ends count from 0
+    inner_->runBatch(cells, splits, r.pairs, r.cellEnds, r.stats);
+    const std::size_t base = out.size();
+    out.insert(out.end(), r.pairs.begin(), r.pairs.end());
+    for (const std::size_t end : r.cellEnds) cellEnds.push_back(base + end);
+    stats += r.stats;
+    recording_.push_back(std::move(r));
   }
 
  private:
-  template <typename Run>
-  void paced(bpaccel::RunStats& stats, Run&& run) {
+  std::unique_ptr<bpaccel::Backend> inner_;
+  Recording& recording_;
+};
+
+// A device that takes its modelled time and no more: it answers each
+// hand-over with the recorded answer (so simulating the device costs this
+// thread nothing: the model backend's own all-pairs work would take longer
+// than the device it models) once a command's latency, the load, the run
+// (or the results on the link, if longer) and a completion's latency have
+// passed since the hand-over reached it (handOverTimes, the model's own
+// parts). It holds the device through the completion's latency, which the
+// model overlaps with the next hand-over: 1 us a hand-over more than the model.
+class PacedDevice final : public bpaccel::Backend {
+ public:
+  PacedDevice(const Recording& recording, std::size_t capacity, unsigned keyWidth, bool bipartite,
+              const bpaccel::PipelineModel& model, std::vector<double>& lateSeconds)
+      : recording_(recording), capacity_(capacity), keyWidth_(keyWidth), bipartite_(bipartite), model_(model),
+        late_(lateSeconds) {
+    prctl(PR_SET_TIMERSLACK, 1UL);  // this thread's sleeps end on time, not up to 50 us late
+  }
+  std::string name() const override { return "paced replay"; }
+  std::size_t capacity() const override { return capacity_; }
+  unsigned keyWidth() const override { return keyWidth_; }
+  bool bipartite() const override { return bipartite_; }
+  void run(std::span<const bpaccel::KeyBox>, std::vector<bpaccel::Pair>&, bpaccel::RunStats&) override {
+    throw std::logic_error("frame_timing: the paced device takes batches only");
+  }
+  /// Called before each frame: its hand-overs replay the recording from the start.
+  void rewind() { next_ = 0; }
+  void runBatch(std::span<const std::span<const bpaccel::KeyBox>> cells, std::span<const std::size_t>,
+                std::vector<bpaccel::Pair>& out, std::vector<std::size_t>& cellEnds,
+                bpaccel::RunStats& stats) override {
     const auto reached = Clock::now();
-    bpaccel::RunStats mine;
-    run(mine);
-    stats += mine;
-    const auto t = bpaccel::handOverTimes(mine, model_);
+    if (next_ >= recording_.size() || recording_[next_].cellEnds.size() != cells.size())
+      throw std::logic_error("frame_timing: the paced run's hand-overs differ from the recorded ones");
+    const bpaccel::BatchResult& r = recording_[next_++];
+    const std::size_t base = out.size();
+    out.insert(out.end(), r.pairs.begin(), r.pairs.end());
+    for (const std::size_t end : r.cellEnds) cellEnds.push_back(base + end);
+    stats += r.stats;
+    const auto t = bpaccel::handOverTimes(r.stats, model_);
     const double hold = 2 * model_.latencySeconds + t.loadSeconds + std::max(t.computeSeconds, t.resultsSeconds);
     const auto until = reached + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(hold));
-    std::this_thread::sleep_until(until);
+    // A sleep ends about 15-20 us late here: sleep to near the end, then spin.
+    std::this_thread::sleep_until(until - std::chrono::microseconds(kSpinMicroseconds));
+    while (Clock::now() < until) {
+    }
     late_.push_back(std::chrono::duration<double>(Clock::now() - until).count());
   }
 
-  std::unique_ptr<bpaccel::Backend> inner_;
+ private:
+  static constexpr int kSpinMicroseconds = 30;
+  const Recording& recording_;
+  std::size_t capacity_;
+  unsigned keyWidth_;
+  bool bipartite_;
   bpaccel::PipelineModel model_;
   std::vector<double>& late_;  // per hand-over: how late the device answered (read once a frame has ended)
+  std::size_t next_ = 0;
 };
 
 }  // namespace
@@ -144,7 +189,8 @@ int main(int argc, char** argv) {
   app.add_flag("--evict", evict, "Evict the caches before each frame");
   bool paced = false;
   app.add_flag("--paced", paced,
-               "Also run the asynchronous hand-overs against a device held for its modelled time, and time them");
+               "Also run the asynchronous hand-overs against a device held for its modelled time, and time them "
+               "(recording the synchronous run's answers adds to its allocations)");
   app.add_option("--key-width", keyWidths,
                  "Key widths of the model's device (default: the built hardware's); several: compared. "
                  "Below 32 the host narrows each cell's keys and checks the pairs")
@@ -186,8 +232,10 @@ int main(int argc, char** argv) {
     unsigned keyWidth = 32;
     // --paced: the same configuration's asynchronous hand-overs on a paced device.
     std::unique_ptr<bpaccel::BroadPhase> pacedPhase;
+    std::unique_ptr<Recording> recording = std::make_unique<Recording>();  // the synchronous run's answers
+    PacedDevice* pacedDevice = nullptr;  // owned by pacedPhase's device thread
     std::unique_ptr<std::vector<double>> late = std::make_unique<std::vector<double>>();
-    std::vector<double> pacedWall;
+    std::vector<double> pacedWall, pacedLastReady, lastReady, pacedWaits;
   };
   bpaccel::PipelineModel model;  // the benchmark's link model (--link-gbytes-per-s 4, --link-latency-us 1)
   model.clockHz = clockMHz * 1e6;
@@ -206,11 +254,19 @@ int main(int argc, char** argv) {
                                                       bpaccel::parsePartitionKind(partition));
       t.phase->setFirstBatchCells(first);
       if (paced) {
+        t.backend = std::make_unique<RecordingDevice>(std::move(t.backend), *t.recording);
+        t.phase = std::make_unique<bpaccel::BroadPhase>(*t.backend, cellSize, cellsPerBatch,
+                                                        bpaccel::parsePartitionKind(partition));
+        t.phase->setFirstBatchCells(first);
         bpaccel::PipelineModel deviceModel = model;
         deviceModel.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(keyWidth));
+        // Built on the device's thread while the constructor waits: the pointer is set when it returns.
         t.pacedPhase = std::make_unique<bpaccel::BroadPhase>(
-            [&makeBackend, keyWidth, deviceModel, late = t.late.get()] {
-              return std::make_unique<PacedDevice>(makeBackend(keyWidth), deviceModel, *late);
+            [&t, deviceModel] {
+              auto device = std::make_unique<PacedDevice>(*t.recording, t.backend->capacity(), t.backend->keyWidth(),
+                                                          t.backend->bipartite(), deviceModel, *t.late);
+              t.pacedDevice = device.get();
+              return device;
             },
             cellSize, 1, cellsPerBatch, bpaccel::parsePartitionKind(partition), bpaccel::HandOvers::Asynchronous);
         t.pacedPhase->setFirstBatchCells(first);
@@ -227,6 +283,7 @@ int main(int argc, char** argv) {
       for (std::size_t k = 0; k < timed.size(); ++k) {
         Timed& t = timed[(k + turn) % timed.size()];
         for (std::size_t b = 0; b < flood.size(); b += 64) sink += static_cast<unsigned char>(++flood[b]);
+        t.recording->clear();
         const std::size_t allocationsBefore = gAllocations;
         const auto t0 = Clock::now();
         t.phase->findPairs(recorded[f], pairs);
@@ -252,9 +309,14 @@ int main(int argc, char** argv) {
         }
         if (t.pacedPhase) {
           for (std::size_t b = 0; b < flood.size(); b += 64) sink += static_cast<unsigned char>(++flood[b]);
+          t.pacedDevice->rewind();
           const auto p0 = Clock::now();
           t.pacedPhase->findPairs(recorded[f], pairs);
           t.pacedWall.push_back(std::chrono::duration<double>(Clock::now() - p0).count());
+          // When the producer handed its last batch over, in both runs (waits for room left out).
+          t.pacedLastReady.push_back(t.pacedPhase->runs().back().readySeconds);
+          t.lastReady.push_back(t.phase->runs().back().readySeconds);
+          t.pacedWaits.push_back(t.pacedPhase->times().backendSeconds);
           std::sort(pairs.begin(), pairs.end());
           if (pairs != exact[f]) {
             fmt::print(stderr, "frame_timing: paced frame {} pass {}: {} pairs, the exact set has {}\n", f, p,
@@ -286,6 +348,10 @@ int main(int argc, char** argv) {
                  "the device answered a median {:.1f} us late (max {:.1f}) over {} hand-overs\n",
                  us(t.pacedWall), median(ratio), us(*t.late),
                  t.late->empty() ? 0.0 : *std::max_element(t.late->begin(), t.late->end()) * 1e6, t.late->size());
+      fmt::print("  paced: the producer handed its last batch over at {:.1f} us (its waits left out; {:.1f} us in "
+                 "the synchronous run, which decodes in between)\n",
+                 us(t.pacedLastReady), us(t.lastReady));
+      fmt::print("  paced: the producer waited {:.1f} us a frame for room and for the last decode\n", us(t.pacedWaits));
     }
     if (k > 0) {  // paired with the first configuration, frame by frame
       std::vector<double> ratio;
