@@ -86,7 +86,7 @@ test-host: host
 # The seed's results table: Bullet's broad phases against the accelerator on
 # the bouncing cube, with results/bench.json, plots and a picture of the scene.
 # It runs a device measured on the FPGA (docs/fpga.md; m = 64 routes at
-# 80.81 MHz at 34af26b, placer seed 3, which costs the bench's scene less device time
+# 83.82 MHz at 6b635ea, placer seed 3, which costs the bench's scene less device time
 # than m = 32 at 93.4, measured before bipartite runs): the host is built
 # for BENCH_ARCH and BENCH_M, whose report in
 # results/fpga gives the clock. The other targets keep ARCH and M.
