@@ -129,7 +129,12 @@ class PacedDevice final : public bpaccel::Backend {
     throw std::logic_error("frame_timing: the paced device takes batches only");
   }
   /// Called before each frame: its hand-overs replay the recording from the start.
-  void rewind() { next_ = 0; }
+  void rewind(Clock::time_point frameStart) {
+    next_ = 0;
+    frameStart_ = frameStart;
+  }
+  /// Per hand-over of each frame so far: when it reached the device and when the device answered (s from the frame's start).
+  std::vector<std::vector<std::pair<double, double>>> spans;
   void runBatch(std::span<const std::span<const bpaccel::KeyBox>> cells, std::span<const std::size_t>,
                 std::vector<bpaccel::Pair>& out, std::vector<std::size_t>& cellEnds,
                 bpaccel::RunStats& stats) override {
@@ -148,7 +153,11 @@ class PacedDevice final : public bpaccel::Backend {
     std::this_thread::sleep_until(until - std::chrono::microseconds(kSpinMicroseconds));
     while (Clock::now() < until) {
     }
-    late_.push_back(std::chrono::duration<double>(Clock::now() - until).count());
+    const auto answered = Clock::now();
+    late_.push_back(std::chrono::duration<double>(answered - until).count());
+    if (next_ == 1) spans.emplace_back();
+    spans.back().emplace_back(std::chrono::duration<double>(reached - frameStart_).count(),
+                              std::chrono::duration<double>(answered - frameStart_).count());
   }
 
  private:
@@ -160,6 +169,7 @@ class PacedDevice final : public bpaccel::Backend {
   bpaccel::PipelineModel model_;
   std::vector<double>& late_;  // per hand-over: how late the device answered (read once a frame has ended)
   std::size_t next_ = 0;
+  Clock::time_point frameStart_;
 };
 
 }  // namespace
@@ -235,7 +245,7 @@ int main(int argc, char** argv) {
     std::unique_ptr<Recording> recording = std::make_unique<Recording>();  // the synchronous run's answers
     PacedDevice* pacedDevice = nullptr;  // owned by pacedPhase's device thread
     std::unique_ptr<std::vector<double>> late = std::make_unique<std::vector<double>>();
-    std::vector<double> pacedWall, pacedLastReady, lastReady, pacedWaits;
+    std::vector<double> pacedWall, pacedLastReady, lastReady, pacedWaits, pacedDecode;
   };
   bpaccel::PipelineModel model;  // the benchmark's link model (--link-gbytes-per-s 4, --link-latency-us 1)
   model.clockHz = clockMHz * 1e6;
@@ -309,14 +319,17 @@ int main(int argc, char** argv) {
         }
         if (t.pacedPhase) {
           for (std::size_t b = 0; b < flood.size(); b += 64) sink += static_cast<unsigned char>(++flood[b]);
-          t.pacedDevice->rewind();
           const auto p0 = Clock::now();
+          t.pacedDevice->rewind(p0);
           t.pacedPhase->findPairs(recorded[f], pairs);
           t.pacedWall.push_back(std::chrono::duration<double>(Clock::now() - p0).count());
           // When the producer handed its last batch over, in both runs (waits for room left out).
           t.pacedLastReady.push_back(t.pacedPhase->runs().back().readySeconds);
           t.lastReady.push_back(t.phase->runs().back().readySeconds);
           t.pacedWaits.push_back(t.pacedPhase->times().backendSeconds);
+          double decoding = 0;
+          for (const auto& r : t.pacedPhase->runs()) decoding += r.decodeSeconds;
+          t.pacedDecode.push_back(decoding);
           std::sort(pairs.begin(), pairs.end());
           if (pairs != exact[f]) {
             fmt::print(stderr, "frame_timing: paced frame {} pass {}: {} pairs, the exact set has {}\n", f, p,
@@ -351,7 +364,23 @@ int main(int argc, char** argv) {
       fmt::print("  paced: the producer handed its last batch over at {:.1f} us (its waits left out; {:.1f} us in "
                  "the synchronous run, which decodes in between)\n",
                  us(t.pacedLastReady), us(t.lastReady));
-      fmt::print("  paced: the producer waited {:.1f} us a frame for room and for the last decode\n", us(t.pacedWaits));
+      fmt::print("  paced: the producer waited {:.1f} us a frame for room and for the last decode; the decoder "
+                 "thread decoded for {:.1f} us a frame\n",
+                 us(t.pacedWaits), us(t.pacedDecode));
+    }
+    if (t.pacedPhase && !t.pacedDevice->spans.empty()) {
+      const auto& spans = t.pacedDevice->spans;
+      std::string line;
+      for (std::size_t h = 0; h < spans.front().size(); ++h) {
+        std::vector<double> from, to;
+        for (const auto& frame : spans)
+          if (h < frame.size()) {
+            from.push_back(frame[h].first);
+            to.push_back(frame[h].second);
+          }
+        line += fmt::format(" {:.0f}-{:.0f}", median(from) * 1e6, median(to) * 1e6);
+      }
+      fmt::print("  paced: the device's hand-overs, median us from the frame's start:{}\n", line);
     }
     if (k > 0) {  // paired with the first configuration, frame by frame
       std::vector<double> ratio;
