@@ -76,6 +76,15 @@ double median(std::vector<double> v) {
 // asynchronous hand-overs are the synchronous ones: the tests prove it).
 using Recording = std::vector<bpaccel::BatchResult>;
 
+// Appends one hand-over's own answer to what Backend::runBatch fills.
+void append(const bpaccel::BatchResult& answer, std::vector<bpaccel::Pair>& out, std::vector<std::size_t>& cellEnds,
+            bpaccel::RunStats& stats) {
+  const std::size_t base = out.size();
+  out.insert(out.end(), answer.pairs.begin(), answer.pairs.end());
+  for (const std::size_t end : answer.cellEnds) cellEnds.push_back(base + end);
+  stats += answer.stats;
+}
+
 // The synchronous run's device: the model backend, its answers recorded.
 class RecordingDevice final : public bpaccel::Backend {
  public:
@@ -93,10 +102,7 @@ class RecordingDevice final : public bpaccel::Backend {
                 bpaccel::RunStats& stats) override {
     bpaccel::BatchResult r;  // this hand-over's own: its cell ends count from 0
     inner_->runBatch(cells, splits, r.pairs, r.cellEnds, r.stats);
-    const std::size_t base = out.size();
-    out.insert(out.end(), r.pairs.begin(), r.pairs.end());
-    for (const std::size_t end : r.cellEnds) cellEnds.push_back(base + end);
-    stats += r.stats;
+    append(r, out, cellEnds, stats);
     recording_.push_back(std::move(r));
   }
 
@@ -115,16 +121,15 @@ class RecordingDevice final : public bpaccel::Backend {
 // model overlaps with the next hand-over: 1 us a hand-over more than the model.
 class PacedDevice final : public bpaccel::Backend {
  public:
-  PacedDevice(const Recording& recording, std::size_t capacity, unsigned keyWidth, bool bipartite,
-              const bpaccel::PipelineModel& model, std::vector<double>& lateSeconds)
-      : recording_(recording), capacity_(capacity), keyWidth_(keyWidth), bipartite_(bipartite), model_(model),
-        late_(lateSeconds) {
+  /// `recorded`: the device whose answers `recording` holds (its capacity, key width and runs are this one's).
+  PacedDevice(const Recording& recording, const bpaccel::Backend& recorded, const bpaccel::PipelineModel& model)
+      : recording_(recording), recorded_(recorded), model_(model) {
     prctl(PR_SET_TIMERSLACK, 1UL);  // this thread's sleeps end on time, not up to 50 us late
   }
   std::string name() const override { return "paced replay"; }
-  std::size_t capacity() const override { return capacity_; }
-  unsigned keyWidth() const override { return keyWidth_; }
-  bool bipartite() const override { return bipartite_; }
+  std::size_t capacity() const override { return recorded_.capacity(); }
+  unsigned keyWidth() const override { return recorded_.keyWidth(); }
+  bool bipartite() const override { return recorded_.bipartite(); }
   void run(std::span<const bpaccel::KeyBox>, std::vector<bpaccel::Pair>&, bpaccel::RunStats&) override {
     throw std::logic_error("frame_timing: the paced device takes batches only");
   }
@@ -133,8 +138,11 @@ class PacedDevice final : public bpaccel::Backend {
     next_ = 0;
     frameStart_ = frameStart;
   }
-  /// Per hand-over of each frame so far: when it reached the device and when the device answered (s from the frame's start).
+  // Read once a frame has ended. Per hand-over of each frame so far: when it
+  // reached the device and when the device answered (s from the frame's
+  // start); and how late it answered, all frames together.
   std::vector<std::vector<std::pair<double, double>>> spans;
+  std::vector<double> lateSeconds;
   void runBatch(std::span<const std::span<const bpaccel::KeyBox>> cells, std::span<const std::size_t>,
                 std::vector<bpaccel::Pair>& out, std::vector<std::size_t>& cellEnds,
                 bpaccel::RunStats& stats) override {
@@ -142,10 +150,7 @@ class PacedDevice final : public bpaccel::Backend {
     if (next_ >= recording_.size() || recording_[next_].cellEnds.size() != cells.size())
       throw std::logic_error("frame_timing: the paced run's hand-overs differ from the recorded ones");
     const bpaccel::BatchResult& r = recording_[next_++];
-    const std::size_t base = out.size();
-    out.insert(out.end(), r.pairs.begin(), r.pairs.end());
-    for (const std::size_t end : r.cellEnds) cellEnds.push_back(base + end);
-    stats += r.stats;
+    append(r, out, cellEnds, stats);
     const auto t = bpaccel::handOverTimes(r.stats, model_);
     const double hold = 2 * model_.latencySeconds + t.loadSeconds + std::max(t.computeSeconds, t.resultsSeconds);
     const auto until = reached + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(hold));
@@ -154,7 +159,7 @@ class PacedDevice final : public bpaccel::Backend {
     while (Clock::now() < until) {
     }
     const auto answered = Clock::now();
-    late_.push_back(std::chrono::duration<double>(answered - until).count());
+    lateSeconds.push_back(std::chrono::duration<double>(answered - until).count());
     if (next_ == 1) spans.emplace_back();
     spans.back().emplace_back(std::chrono::duration<double>(reached - frameStart_).count(),
                               std::chrono::duration<double>(answered - frameStart_).count());
@@ -163,11 +168,8 @@ class PacedDevice final : public bpaccel::Backend {
  private:
   static constexpr int kSpinMicroseconds = 30;
   const Recording& recording_;
-  std::size_t capacity_;
-  unsigned keyWidth_;
-  bool bipartite_;
+  const bpaccel::Backend& recorded_;
   bpaccel::PipelineModel model_;
-  std::vector<double>& late_;  // per hand-over: how late the device answered (read once a frame has ended)
   std::size_t next_ = 0;
   Clock::time_point frameStart_;
 };
@@ -244,7 +246,6 @@ int main(int argc, char** argv) {
     std::unique_ptr<bpaccel::BroadPhase> pacedPhase;
     std::unique_ptr<Recording> recording = std::make_unique<Recording>();  // the synchronous run's answers
     PacedDevice* pacedDevice = nullptr;  // owned by pacedPhase's device thread
-    std::unique_ptr<std::vector<double>> late = std::make_unique<std::vector<double>>();
     std::vector<double> pacedWall, pacedLastReady, lastReady, pacedWaits, pacedDecode;
   };
   bpaccel::PipelineModel model;  // the benchmark's link model (--link-gbytes-per-s 4, --link-latency-us 1)
@@ -260,21 +261,17 @@ int main(int argc, char** argv) {
       Timed t;
       t.keyWidth = keyWidth;
       t.backend = makeBackend(keyWidth);
+      if (paced) t.backend = std::make_unique<RecordingDevice>(std::move(t.backend), *t.recording);
       t.phase = std::make_unique<bpaccel::BroadPhase>(*t.backend, cellSize, cellsPerBatch,
                                                       bpaccel::parsePartitionKind(partition));
       t.phase->setFirstBatchCells(first);
       if (paced) {
-        t.backend = std::make_unique<RecordingDevice>(std::move(t.backend), *t.recording);
-        t.phase = std::make_unique<bpaccel::BroadPhase>(*t.backend, cellSize, cellsPerBatch,
-                                                        bpaccel::parsePartitionKind(partition));
-        t.phase->setFirstBatchCells(first);
         bpaccel::PipelineModel deviceModel = model;
         deviceModel.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(keyWidth));
         // Built on the device's thread while the constructor waits: the pointer is set when it returns.
         t.pacedPhase = std::make_unique<bpaccel::BroadPhase>(
             [&t, deviceModel] {
-              auto device = std::make_unique<PacedDevice>(*t.recording, t.backend->capacity(), t.backend->keyWidth(),
-                                                          t.backend->bipartite(), deviceModel, *t.late);
+              auto device = std::make_unique<PacedDevice>(*t.recording, *t.backend, deviceModel);
               t.pacedDevice = device.get();
               return device;
             },
@@ -354,13 +351,14 @@ int main(int argc, char** argv) {
                us(t.pipelined), clockMHz, pairs.size(), stats.hits, stats.runs, stats.batches, stats.deviceCycles(),
                median(t.allocations));
     if (t.pacedPhase) {
+      const auto& late = t.pacedDevice->lateSeconds;
       std::vector<double> ratio;
       for (std::size_t i = 0; i < t.pacedWall.size(); ++i) ratio.push_back(t.pacedWall[i] / t.pipelined[i]);
       fmt::print("  paced: asynchronous hand-overs against a device held for its modelled time: frame_us {:.1f} "
                  "(measured wall time; device emulated), per frame {:.3f}x the modelled overlapped frame; "
                  "the device answered a median {:.1f} us late (max {:.1f}) over {} hand-overs\n",
-                 us(t.pacedWall), median(ratio), us(*t.late),
-                 t.late->empty() ? 0.0 : *std::max_element(t.late->begin(), t.late->end()) * 1e6, t.late->size());
+                 us(t.pacedWall), median(ratio), us(late),
+                 late.empty() ? 0.0 : *std::max_element(late.begin(), late.end()) * 1e6, late.size());
       fmt::print("  paced: the producer handed its last batch over at {:.1f} us (its waits left out; {:.1f} us in "
                  "the synchronous run, which decodes in between)\n",
                  us(t.pacedLastReady), us(t.lastReady));
@@ -368,7 +366,7 @@ int main(int argc, char** argv) {
                  "thread decoded for {:.1f} us a frame\n",
                  us(t.pacedWaits), us(t.pacedDecode));
     }
-    if (t.pacedPhase && !t.pacedDevice->spans.empty()) {
+    if (t.pacedPhase && !t.pacedDevice->spans.empty()) {  // hand-over h's median span over the frames
       const auto& spans = t.pacedDevice->spans;
       std::string line;
       for (std::size_t h = 0; h < spans.front().size(); ++h) {
