@@ -7,7 +7,8 @@
 namespace bpaccel {
 
 // The stage's bound is not the host's: a caller may submit as many hand-overs as it likes.
-AsyncBackend::AsyncBackend(const DeviceFactory& makeDevice) : stage_(std::numeric_limits<std::size_t>::max()) {
+AsyncBackend::AsyncBackend(const DeviceFactory& makeDevice, std::chrono::microseconds spinBeforeSleep)
+    : stage_(std::numeric_limits<std::size_t>::max(), spinBeforeSleep) {
   stage_.post([this, &makeDevice] {
     device_ = makeDevice();
     if (!device_) throw std::invalid_argument("async backend: the device factory gave no device");
@@ -39,6 +40,15 @@ std::future<BatchResult> AsyncBackend::submit(std::span<const std::span<const Ke
   auto result = job->get_future();
   stage_.post([job] { (*job)(); });  // a failure goes to this hand-over's future, not the stage
   return result;
+}
+
+void AsyncBackend::wake() {
+  stage_.post([] {});
+}
+
+void AsyncBackend::awaken() {
+  wake();
+  stage_.drain();  // hand-overs fail through their futures, not the stage: nothing to rethrow
 }
 
 }  // namespace bpaccel

@@ -2,6 +2,7 @@
 // A backend on a thread of its own: hand-overs are submitted, and their
 // results collected later while the caller goes on.
 
+#include <chrono>
 #include <cstddef>
 #include <functional>
 #include <future>
@@ -34,10 +35,14 @@ struct BatchResult {
 /// (Verilator's rule; RtlBackend deadlocked at destruction otherwise). The
 /// constructor returns once the device exists, and rethrows its failure.
 /// Destruction finishes every hand-over submitted before it.
+///
+/// `spinBeforeSleep`: the device's thread polls for the next hand-over that
+/// long after each one (SerialStage), as a card takes a doorbell without a
+/// wake-up; wake() starts it polling ahead of a frame's first hand-over.
 class AsyncBackend {
  public:
   using DeviceFactory = std::function<std::unique_ptr<Backend>()>;
-  explicit AsyncBackend(const DeviceFactory& makeDevice);
+  explicit AsyncBackend(const DeviceFactory& makeDevice, std::chrono::microseconds spinBeforeSleep = {});
   ~AsyncBackend();
   AsyncBackend(const AsyncBackend&) = delete;
   AsyncBackend& operator=(const AsyncBackend&) = delete;
@@ -50,6 +55,12 @@ class AsyncBackend {
   /// their bipartite splits as Backend::runBatch takes them (empty: none).
   std::future<BatchResult> submit(std::span<const std::span<const KeyBox>> cells,
                                   std::span<const std::size_t> splits = {});
+  /// Wakes the device's thread, so that it polls (with spinBeforeSleep) by
+  /// the time the next hand-over comes; a no-op on its queue. Returns at once.
+  void wake();
+  /// The same, and returns once the device's thread is awake (and polling,
+  /// with spinBeforeSleep), after every hand-over submitted before.
+  void awaken();
 
  private:
   std::unique_ptr<Backend> device_;  // built, used and destroyed on the stage's thread only

@@ -5,6 +5,7 @@
 #include <future>
 #include <numeric>
 #include <stdexcept>
+#include <thread>
 #include <utility>
 
 #include <fmt/format.h>
@@ -102,7 +103,8 @@ struct BroadPhase::Worker {
   };
   std::array<HandedOver, kBatchesInFlight> handedOver;
   std::size_t handOversThisFrame = 0;
-  std::unique_ptr<SerialStage> decoder;
+  std::unique_ptr<SerialStage> decoder;  // Asynchronous; Polled decodes on this worker's thread
+  std::size_t decodedThisFrame = 0;      // Polled: hand-overs decoded, in order
   std::vector<std::size_t> cellEnds;
   static constexpr std::size_t kSizeBuckets = 256;
   std::vector<std::uint32_t> bucketStarts;  // flush's counting sort of a batch's cells by size
@@ -122,6 +124,15 @@ struct BroadPhase::Worker {
   void flush();   // hands the batch being filled over, if any
   void finish();  // flush, then (asynchronous) wait until every batch handed over is decoded
   void handOverAsynchronously(std::span<const std::span<const KeyBox>> toDevice);
+  void handOverPolled(std::span<const std::span<const KeyBox>> toDevice);
+  // Polled: the oldest hand-over not yet decoded, polled for until it has
+  // arrived; then decoded (its failure rethrown).
+  void decodeOldest();
+  // Polled: decodes, in order, the hand-overs whose answers have arrived.
+  void decodeArrived();
+  // Polled: waits out the hand-overs a failed frame left with the device,
+  // whose answers nobody will decode (their batches' storage is reused).
+  void abandonOutstanding();
   void startFrame(Clock::time_point start);
   // Appends a batch's kept pairs, given the backend's pairs and cell ends for it.
   void decodeBatch(const Batch& batch, std::span<const Pair> pairs, std::span<const std::size_t> ends);
@@ -186,18 +197,21 @@ BroadPhase::BroadPhase(const BackendFactory& makeBackend, std::optional<std::siz
     : cellSize_(cellSize), cellsPerBatch_(cellsPerBatch), handOvers_(handOvers),
       partition_(makePartition(partition)) {
   if (threads < 1) throw std::invalid_argument("broad phase: at least one thread");
-  const bool async = handOvers == HandOvers::Asynchronous;
+  const bool async = handOvers != HandOvers::Synchronous;
   if (async && cellsPerBatch < 2)
     throw std::invalid_argument("broad phase: asynchronous hand-overs need at least two cells per batch");
+  const bool polled = handOvers == HandOvers::Polled;
   for (std::size_t t = 0; t < threads; ++t) {
     auto w = std::make_unique<Worker>();
     if (async) {
-      w->async = std::make_unique<AsyncBackend>([&] {
-        auto device = makeBackend();
-        if (!device) throw std::invalid_argument("broad phase: the backend factory gave no backend");
-        return device;
-      });
-      w->decoder = std::make_unique<SerialStage>(kBatchesInFlight);
+      w->async = std::make_unique<AsyncBackend>(
+          [&] {
+            auto device = makeBackend();
+            if (!device) throw std::invalid_argument("broad phase: the backend factory gave no backend");
+            return device;
+          },
+          polled ? kDevicePollMicroseconds : std::chrono::microseconds{});
+      if (!polled) w->decoder = std::make_unique<SerialStage>(kBatchesInFlight);
     } else {
       w->owned = makeBackend();
       if (!w->owned) throw std::invalid_argument("broad phase: the backend factory gave no backend");
@@ -217,6 +231,11 @@ void BroadPhase::configureWorkers() {
     w->firstBatchCells = firstBatchCells();
     w->keyWidth = w->async ? w->async->keyWidth() : w->backend->keyWidth();
   }
+}
+
+void BroadPhase::awakenDevices() {
+  if (handOvers_ != HandOvers::Polled) return;
+  for (auto& w : workers_) w->async->awaken();
 }
 
 void BroadPhase::setFirstBatchCells(std::size_t cells) {
@@ -359,7 +378,12 @@ void BroadPhase::Worker::startFrame(Clock::time_point start) {
     } catch (...) {
     }
   }
+  if (async && !decoder) {
+    abandonOutstanding();
+    async->wake();  // polling by the time the partition has the first batch
+  }
   handOversThisFrame = 0;
+  decodedThisFrame = 0;
   filling.clear();
   out.clear();
   stats = {};
@@ -504,7 +528,10 @@ void BroadPhase::Worker::flush() {
     filling.clear();
     return;
   }
-  handOverAsynchronously(toDevice);
+  if (decoder)
+    handOverAsynchronously(toDevice);
+  else
+    handOverPolled(toDevice);
 }
 
 // The batch goes to the device and its decoding to the decoder thread, which
@@ -540,8 +567,66 @@ void BroadPhase::Worker::handOverAsynchronously(std::span<const std::span<const 
   });
 }
 
+// The batch goes to the device, and the answers that have arrived are
+// decoded here before the producer goes on; with kBatchesInFlight batches
+// handed over and not yet decoded, it first polls for the oldest's answer
+// (time waiting for the device, not host work) and decodes it.
+void BroadPhase::Worker::handOverPolled(std::span<const std::span<const KeyBox>> toDevice) {
+  RunRecord record;
+  record.readySeconds = seconds(frameStart, Clock::now()) - backendSeconds;
+  if (handOversThisFrame - decodedThisFrame == kBatchesInFlight) decodeOldest();
+  HandedOver& slot = handedOver[handOversThisFrame++ % kBatchesInFlight];
+  slot.result = async->submit(toDevice, filling.splits);
+  std::swap(filling, slot.batch);  // as handOverAsynchronously
+  filling.clear();
+  slot.record = record;
+  decodeArrived();
+}
+
+void BroadPhase::Worker::decodeOldest() {
+  HandedOver& slot = handedOver[decodedThisFrame % kBatchesInFlight];
+  const auto from = Clock::now();
+  // Polled for, as the device's thread polls for hand-overs: sleeping on the
+  // future would cost a wake-up when it is set. Beyond kDevicePollMicroseconds
+  // (a long run, or more polling threads than cores) it sleeps after all.
+  while (slot.result.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+    if (Clock::now() - from > kDevicePollMicroseconds) {
+      slot.result.wait();
+      break;
+    }
+    __builtin_ia32_pause();
+  }
+  const auto got = Clock::now();
+  backendSeconds += seconds(from, got);
+  ++decodedThisFrame;  // first: a failure leaves the next one the oldest
+  BatchResult result = slot.result.get();  // rethrows the device's failure
+  stats += result.stats;
+  decodeBatch(slot.batch, result.pairs, result.cellEnds);
+  slot.record.stats = result.stats;
+  slot.record.decodeSeconds = seconds(got, Clock::now());
+  runs.push_back(slot.record);
+}
+
+void BroadPhase::Worker::decodeArrived() {
+  while (decodedThisFrame < handOversThisFrame &&
+         handedOver[decodedThisFrame % kBatchesInFlight].result.wait_for(std::chrono::seconds(0)) ==
+             std::future_status::ready)
+    decodeOldest();
+}
+
+void BroadPhase::Worker::abandonOutstanding() {
+  for (; decodedThisFrame < handOversThisFrame; ++decodedThisFrame) {
+    auto& result = handedOver[decodedThisFrame % kBatchesInFlight].result;
+    if (result.valid()) result.wait();
+  }
+}
+
 void BroadPhase::Worker::finish() {
   flush();
+  if (async && !decoder) {
+    while (decodedThisFrame < handOversThisFrame) decodeOldest();
+    return;
+  }
   if (!decoder) return;
   const auto waitFrom = Clock::now();
   decoder->drain();  // every batch decoded; rethrows the first failure

@@ -36,9 +36,28 @@ struct HostTimes {
 /// decoder thread (SerialStage) waits for each batch's answer and decodes
 /// it. At most kBatchesInFlight batches are handed over and not yet
 /// decoded; the worker waits for the oldest before it hands over one more.
-/// This is the schedule modelPipeline models. The pairs (in the same order),
-/// the counters and the hand-overs are the same either way.
-enum class HandOvers { Synchronous, Asynchronous };
+/// This is the schedule modelPipeline models.
+///
+/// Polled: two threads, where a card would leave one. The device runs on a
+/// thread of its own as with Asynchronous, and that thread polls for the
+/// next hand-over (AsyncBackend's spinBeforeSleep, kDevicePollMicroseconds)
+/// as a card takes a doorbell; the worker's thread decodes the answers
+/// itself: after each hand-over it decodes those that have arrived, and it
+/// polls (spins) for an answer it must have: for room (kBatchesInFlight) and
+/// at the frame's end. No thread waits to be woken during a frame, which on
+/// the virtual machines here cost 22-62 us a wake-up, but each polling
+/// thread takes a core. modelPipeline models it with
+/// PipelineModel::decodeOnProducer.
+///
+/// The pairs (in the same order), the counters and the hand-overs are the
+/// same in all three.
+enum class HandOvers { Synchronous, Asynchronous, Polled };
+
+/// How long a polled device's thread (HandOvers::Polled) polls for the next
+/// hand-over after each one before it sleeps: longer than the gaps between a
+/// frame's hand-overs here (up to about 0.1 ms), short enough that it sleeps
+/// between frames.
+inline constexpr std::chrono::microseconds kDevicePollMicroseconds{250};
 
 /// Finds every overlapping pair of a scene exactly once. Without a cell size
 /// the scene is one cell. A cell larger than the backend's capacity is
@@ -100,6 +119,12 @@ class BroadPhase {
     return firstBatchCells_ ? std::min(firstBatchCells_, cellsPerBatch_) : cellsPerBatch_;
   }
   HandOvers handOvers() const { return handOvers_; }
+  /// Polled hand-overs: returns once every worker's device thread is awake
+  /// and polling for the next hand-over (for kDevicePollMicroseconds).
+  /// Where the device stands for a card, which needs no waking, a caller
+  /// that times a frame calls it first; findPairs wakes them too, but
+  /// without waiting. Does nothing with other hand-overs.
+  void awakenDevices();
   /// The last call's hand-overs to the backend (batches, or single runs) in
   /// order, with the measured host time at which each was ready and its
   /// decoding took (for modelPipeline). With several threads, each worker's

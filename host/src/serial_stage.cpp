@@ -5,8 +5,10 @@
 
 namespace bpaccel {
 
-SerialStage::SerialStage(std::size_t maxPending) : maxPending_(maxPending) {
+SerialStage::SerialStage(std::size_t maxPending, std::chrono::microseconds spinBeforeSleep)
+    : maxPending_(maxPending), spinBeforeSleep_(spinBeforeSleep) {
   if (maxPending < 1) throw std::invalid_argument("serial stage: at least one task must be allowed outstanding");
+  if (spinBeforeSleep.count() < 0) throw std::invalid_argument("serial stage: a negative time to poll before sleeping");
   thread_ = std::jthread([this](std::stop_token stop) { serve(std::move(stop)); });
 }
 
@@ -23,6 +25,7 @@ void SerialStage::post(std::function<void()> task) {
     std::unique_lock lock(mutex_);
     finished_.wait(lock, [this] { return outstanding_ < maxPending_; });
     tasks_.push_back(std::move(task));
+    queued_.store(tasks_.size(), std::memory_order_release);
     ++outstanding_;
   }
   taskReady_.notify_one();
@@ -45,6 +48,13 @@ bool SerialStage::failed() {
 
 void SerialStage::serve(std::stop_token stop) {
   for (;;) {
+    if (spinBeforeSleep_.count() > 0) {
+      const auto until = std::chrono::steady_clock::now() + spinBeforeSleep_;
+      while (queued_.load(std::memory_order_acquire) == 0 && !stop.stop_requested() &&
+             std::chrono::steady_clock::now() < until) {
+        __builtin_ia32_pause();
+      }
+    }
     std::function<void()> task;
     {
       std::unique_lock lock(mutex_);
@@ -53,6 +63,7 @@ void SerialStage::serve(std::stop_token stop) {
       if (tasks_.empty()) return;
       task = std::move(tasks_.front());
       tasks_.pop_front();
+      queued_.store(tasks_.size(), std::memory_order_release);
     }
     std::exception_ptr failure;
     try {

@@ -17,17 +17,80 @@ HandOverTimes handOverTimes(const RunStats& s, const PipelineModel& model) {
   return t;
 }
 
+namespace {
+
+// The link and the device, shared by both hosts: each run takes them in turn.
+class DeviceLanes {
+ public:
+  DeviceLanes(const PipelineModel& model, FrameTimeline& t) : model_(model), t_(t) {}
+  // Run i handed over at `ready`: returns when its answer reaches the host.
+  double run(std::size_t i, const RunStats& s, double ready) {
+    const auto [boxes, load, compute, results] = handOverTimes(s, model_);
+    const double start = std::max({ready + model_.latencySeconds, linkFree_, deviceFree_});
+    t_.link.push_back({start, start + boxes, i});
+    if (results > 0) t_.link.push_back({start + load, start + load + results, i});
+    t_.device.push_back({start, start + load + compute, i});
+    deviceFree_ = start + load + compute;
+    linkFree_ = std::max(start + boxes, start + load + results);
+    return std::max(deviceFree_, start + load + results) + model_.latencySeconds;
+  }
+
+ private:
+  const PipelineModel& model_;
+  FrameTimeline& t_;
+  double linkFree_ = 0, deviceFree_ = 0;
+};
+
+// HandOvers::Polled: one host thread produces and decodes, in the code's
+// order (BroadPhase::Worker::handOverPolled, decodeOldest, finish).
+FrameTimeline modelPolled(const std::vector<RunRecord>& runs, double hostSeconds, const PipelineModel& model) {
+  FrameTimeline t;
+  DeviceLanes lanes(model, t);
+  std::vector<double> arrived;
+  arrived.reserve(runs.size());
+  double now = 0;            // the producer's clock
+  double ownBefore = 0;      // the producer's own work (the serial run's, less its decoding) up to the last run
+  double decodedBefore = 0;  // decoding the serial run did before this run was ready
+  std::size_t decoded = 0;
+  const auto decodeOldest = [&] {
+    const double start = std::max(now, arrived[decoded]);
+    now = start + runs[decoded].decodeSeconds;
+    t.decode.push_back({start, now, decoded});
+    ++decoded;
+  };
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const double own = std::max(ownBefore, runs[i].readySeconds - decodedBefore);
+    decodedBefore += runs[i].decodeSeconds;
+    t.produce.push_back({now, now + own - ownBefore, i});
+    now += own - ownBefore;
+    ownBefore = own;
+    if (i - decoded == model.batchesInFlight) decodeOldest();
+    arrived.push_back(lanes.run(i, runs[i].stats, now));
+    while (decoded < i + 1 && arrived[decoded] <= now) decodeOldest();
+  }
+  const double tail = std::max(0.0, hostSeconds - decodedBefore - ownBefore);
+  if (tail > 0) t.produce.push_back({now, now + tail, runs.size()});
+  now += tail;
+  t.producerSeconds = now;
+  while (decoded < runs.size()) decodeOldest();
+  t.frameSeconds = now;
+  return t;
+}
+
+}  // namespace
+
 FrameTimeline modelPipeline(const std::vector<RunRecord>& runs, double hostSeconds, const PipelineModel& model) {
   if (!(model.clockHz > 0) || !(model.bandwidthBytesPerSecond > 0) || model.latencySeconds < 0)
     throw std::invalid_argument("pipeline model: clock and bandwidth must be positive, latency not negative");
   if (model.batchesInFlight < 1) throw std::invalid_argument("pipeline model: at least one batch in flight");
+  if (model.decodeOnProducer) return modelPolled(runs, hostSeconds, model);
   FrameTimeline t;
+  DeviceLanes lanes(model, t);
   double decodedBefore = 0;  // decoding the serial run did before this run was ready
   double waited = 0;         // the producer's waits for a free batch so far
-  double linkFree = 0, deviceFree = 0, decodeFree = 0, produceStart = 0;
+  double decodeFree = 0, produceStart = 0;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const RunRecord& r = runs[i];
-    const RunStats& s = r.stats;
     // The producer no longer decodes: each run is ready that much earlier,
     // and as much later as it waited for room.
     double ready = std::max(0.0, r.readySeconds - decodedBefore) + waited;
@@ -42,14 +105,7 @@ FrameTimeline modelPipeline(const std::vector<RunRecord>& runs, double hostSecon
     t.produce.push_back({produceStart, ready, i});
     produceStart = ready;
 
-    const auto [boxes, load, compute, results] = handOverTimes(s, model);
-    const double start = std::max({ready + model.latencySeconds, linkFree, deviceFree});
-    t.link.push_back({start, start + boxes, i});
-    if (results > 0) t.link.push_back({start + load, start + load + results, i});
-    t.device.push_back({start, start + load + compute, i});
-    deviceFree = start + load + compute;
-    linkFree = std::max(start + boxes, start + load + results);
-    const double arrived = std::max(deviceFree, start + load + results) + model.latencySeconds;
+    const double arrived = lanes.run(i, r.stats, ready);
     const double decodeStart = std::max(arrived, decodeFree);
     decodeFree = decodeStart + r.decodeSeconds;
     t.decode.push_back({decodeStart, decodeFree, i});

@@ -32,6 +32,10 @@ struct PipelineModel {
   double bytesPerBox = 24;
   double bytesPerBeat = 4;
   std::size_t batchesInFlight = kBatchesInFlight;  // the host's bound (at least 1)
+  /// The producer decodes the answers itself (HandOvers::Polled): after each
+  /// hand-over those that have arrived, and for room or at the frame's end
+  /// it waits for the oldest. Otherwise a decoder thread does (Asynchronous).
+  bool decodeOnProducer = false;
 };
 
 /// One hand-over's modelled parts, from its counters.
@@ -57,6 +61,8 @@ struct Span {
 /// order, once they have arrived. With batchesInFlight runs handed over and
 /// not yet decoded, the producer waits for the oldest one's decoding before
 /// it hands over the next (and all its later work moves by that wait).
+/// With decodeOnProducer there is no decoder thread: the producer decodes
+/// (see PipelineModel), and its later work moves by each decode and wait.
 /// A run waits for the device and the link to be free: its boxes stream in
 /// through the load port, as fast as the slower of the link and the port
 /// (one box a cycle), the device computes, result beats return over the

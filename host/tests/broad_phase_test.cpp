@@ -381,12 +381,54 @@ TEST(ModelPipeline, HoldsTheProducerBackWhileItsBatchesInFlightAreUndecoded) {
   EXPECT_THROW(modelPipeline({first, second}, 15e-6, model), std::invalid_argument);
 }
 
+TEST(ModelPipeline, PolledDecodesOnTheProducerBetweenHandOversAsWorkedOutByHand) {
+  // 1 us a cycle, one box a microsecond on the link, one beat a microsecond, no latency.
+  PipelineModel model{1e6, 24e6, 0, 24, 24};
+  std::vector<RunRecord> runs(3);
+  runs[0].readySeconds = 10e-6;
+  runs[0].decodeSeconds = 2e-6;
+  runs[0].stats.boxesSent = 4;
+  runs[0].stats.loadCycles = 5;
+  runs[0].stats.cycles = 1;
+  runs[0].stats.beatsReceived = 3;  // on the link 15..18: arrives at 18
+  runs[1].readySeconds = 22e-6;     // the serial run's clock: 20 us of own work and the first decode
+  runs[1].decodeSeconds = 1e-6;
+  runs[1].stats.boxesSent = runs[1].stats.loadCycles = 1;
+  runs[2].readySeconds = 24e-6;  // 21 us of own work
+  runs[2].decodeSeconds = 1e-6;
+  runs[2].stats.boxesSent = runs[2].stats.loadCycles = runs[2].stats.cycles = 1;
+  const double host = 28e-6;  // 3 us of own work after the last hand-over
+  // A decoder thread: the third is handed over at 21, runs 21..23, decoded 23..24; the producer ends at 24.
+  EXPECT_NEAR(modelPipeline(runs, host, model).frameSeconds, 24e-6, 1e-12);
+  // The producer decoding: the second goes at 20 (device 20..21); then it
+  // decodes the first (20..22) and the second (22..23), both arrived; it
+  // hands the third over at 24 (device 24..26), works until 27, decodes 27..28.
+  model.decodeOnProducer = true;
+  const auto t = modelPipeline(runs, host, model);
+  ASSERT_EQ(t.decode.size(), 3u);
+  EXPECT_NEAR(t.decode[0].start, 20e-6, 1e-12);
+  EXPECT_NEAR(t.decode[1].start, 22e-6, 1e-12);
+  EXPECT_NEAR(t.decode[1].end, 23e-6, 1e-12);
+  EXPECT_NEAR(t.device[2].start, 24e-6, 1e-12);
+  EXPECT_NEAR(t.producerSeconds, 27e-6, 1e-12);
+  EXPECT_NEAR(t.frameSeconds, 28e-6, 1e-12);
+  // With one batch in flight it waits for each answer before the next hand-over:
+  // the first decoded 20..22, the second handed over at 22 (device 22..23), decoded 23..24 at the third's hand-over.
+  model.batchesInFlight = 1;
+  const auto one = modelPipeline(runs, host, model);
+  EXPECT_NEAR(one.device[1].start, 22e-6, 1e-12);
+  EXPECT_NEAR(one.decode[1].start, 23e-6, 1e-12);
+  EXPECT_NEAR(one.device[2].start, 24e-6, 1e-12);
+  EXPECT_NEAR(one.frameSeconds, 28e-6, 1e-12);
+}
+
 TEST(ModelPipeline, NeverBeatsTheBusiestLaneNorLosesToTheSerialSum) {
   std::mt19937 rng(8);
   std::uniform_real_distribution<double> us(0, 5e-6);
   PipelineModel model{100e6, 4e9, 1e-6, 24, 4};
-  for (int trial = 0; trial < 200; ++trial) {
+  for (int trial = 0; trial < 400; ++trial) {
     model.batchesInFlight = 1 + trial % 4;  // however few batches the host may have out
+    model.decodeOnProducer = trial % 8 >= 4;  // and whichever thread decodes
     std::vector<RunRecord> runs(1 + rng() % 30);
     double ready = 0, host = 0, device = 0, serial = 0;
     for (auto& r : runs) {
@@ -771,17 +813,19 @@ TEST(AsyncBackend, RethrowsAFailedDeviceConstructionFromItsOwnConstructor) {
                std::invalid_argument);  // one cell per batch: nothing to overlap
 }
 
-TEST(BroadPhase, AsynchronousHandOversGiveTheSynchronousPairsCountersAndRecords) {
+TEST(BroadPhase, AsynchronousAndPolledHandOversGiveTheSynchronousPairsCountersAndRecords) {
+  for (const HandOvers handOvers : {HandOvers::Asynchronous, HandOvers::Polled})
   for (const PartitionKind partition : {PartitionKind::KdTree, PartitionKind::UniformGrid})
     for (std::size_t perBatch : {2u, 5u, 64u})
       for (std::size_t n : {0u, 2u, 300u, 1000u})
         for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 21)) {
-          const std::string label = name + " n " + std::to_string(n) + " per batch " + std::to_string(perBatch);
+          const std::string label = name + " n " + std::to_string(n) + " per batch " + std::to_string(perBatch) +
+                                    (handOvers == HandOvers::Polled ? " polled" : " decoder thread");
           ModelBackend syncModel(2, 64, 5);
           BroadPhase sync(syncModel, 16, perBatch, partition);
           BroadPhase async([] { return std::make_unique<ModelBackend>(2, 64, 5); }, 16, 1, perBatch, partition,
-                           HandOvers::Asynchronous);
-          EXPECT_EQ(async.handOvers(), HandOvers::Asynchronous);
+                           handOvers);
+          EXPECT_EQ(async.handOvers(), handOvers);
           if (perBatch == 64) {  // with a slow start (hand-overs of 3, 6, 12, ...) on both
             sync.setFirstBatchCells(3);
             async.setFirstBatchCells(3);
@@ -801,27 +845,32 @@ TEST(BroadPhase, AsynchronousHandOversGiveTheSynchronousPairsCountersAndRecords)
         }
 }
 
-TEST(BroadPhase, AsynchronousHandOversWorkOnSeveralThreads) {
-  BroadPhase bp([] { return std::make_unique<ModelBackend>(2, 6, 5); }, 16, 2, 5, PartitionKind::KdTree,
-                HandOvers::Asynchronous);
-  for (std::size_t n : {2u, 300u, 1000u})
-    for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 23)) {
-      std::vector<Pair> pairs;
-      bp.findPairs(boxes, pairs);
-      EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << name;
-    }
+TEST(BroadPhase, AsynchronousAndPolledHandOversWorkOnSeveralThreads) {
+  for (const HandOvers handOvers : {HandOvers::Asynchronous, HandOvers::Polled}) {
+    BroadPhase bp([] { return std::make_unique<ModelBackend>(2, 6, 5); }, 16, 2, 5, PartitionKind::KdTree,
+                  handOvers);
+    for (std::size_t n : {2u, 300u, 1000u})
+      for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 23)) {
+        std::vector<Pair> pairs;
+        bp.findPairs(boxes, pairs);
+        EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << name << (handOvers == HandOvers::Polled ? " polled" : "");
+      }
+  }
 }
 
-TEST(BroadPhase, AsynchronousHandOversPassADeviceFailureOnAndRecover) {
+TEST(BroadPhase, AsynchronousAndPolledHandOversPassADeviceFailureOnAndRecover) {
   const auto boxes = scatteredBoxes(400, 5, 0.0f, 20.0f, 0.5f, 2.0f);
-  for (std::size_t failAt : {1u, 2u, 3u}) {
-    BroadPhase bp([failAt] { return std::make_unique<FailingModel>(failAt); }, 8, 1, 4, PartitionKind::KdTree,
-                  HandOvers::Asynchronous);
-    std::vector<Pair> pairs;
-    EXPECT_THROW(bp.findPairs(boxes, pairs), std::runtime_error) << "failing hand-over " << failAt;
-    bp.findPairs(boxes, pairs);  // the device answers again: the next frame is whole
-    EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << "failing hand-over " << failAt;
-  }
+  for (const HandOvers handOvers : {HandOvers::Asynchronous, HandOvers::Polled})
+    for (std::size_t failAt : {1u, 2u, 3u}) {
+      const std::string label = "failing hand-over " + std::to_string(failAt) +
+                                (handOvers == HandOvers::Polled ? " polled" : " decoder thread");
+      BroadPhase bp([failAt] { return std::make_unique<FailingModel>(failAt); }, 8, 1, 4, PartitionKind::KdTree,
+                    handOvers);
+      std::vector<Pair> pairs;
+      EXPECT_THROW(bp.findPairs(boxes, pairs), std::runtime_error) << label;
+      bp.findPairs(boxes, pairs);  // the device answers again: the next frame is whole
+      EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << label;
+    }
 }
 
 // A device that compares narrower keys than the host's gets each cell's keys

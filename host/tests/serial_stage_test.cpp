@@ -94,3 +94,21 @@ TEST(SerialStage, FinishesQueuedTasksWhenDestroyed) {
 }
 
 TEST(SerialStage, RefusesABoundOfZero) { EXPECT_THROW(SerialStage(0), std::invalid_argument); }
+
+TEST(SerialStage, APollingStageRunsTasksInOrderAndStopsWhileItPolls) {
+  std::vector<int> order;
+  const auto start = std::chrono::steady_clock::now();
+  {
+    // Polls for up to 10 s after each task: the destructor's stop must end that at once.
+    SerialStage stage(2, std::chrono::seconds(10));
+    for (int k = 0; k < 20; ++k) {
+      stage.post([&, k] { order.push_back(k); });
+      if (k % 5 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));  // the thread is polling
+    }
+    stage.drain();
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+  ASSERT_EQ(order.size(), 20u);
+  for (int k = 0; k < 20; ++k) EXPECT_EQ(order[k], k);
+  EXPECT_THROW(SerialStage(1, std::chrono::microseconds(-1)), std::invalid_argument);
+}
