@@ -7,6 +7,7 @@ add_library(bpaccel_core STATIC
   ${CMAKE_CURRENT_LIST_DIR}/../src/backend.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/async_backend.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/serial_stage.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/../src/paced_device.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/all_pairs_kernel.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/partition.cpp
   ${CMAKE_CURRENT_LIST_DIR}/../src/kd_tree.cpp

@@ -13,13 +13,15 @@
 // buffer larger than the caches before each frame, as the benchmark's other
 // methods do between two frames of this one.
 //
-// --paced also runs each configuration's asynchronous hand-overs
-// (HandOvers::Asynchronous: the producer, the device's thread and the decoder
-// thread) against a device held for its modelled time (PacedDevice), and
-// prints that frame's measured wall time beside the modelled overlapped
-// frame: a check of the model against the threads that run it. The paced
-// device replays the model backend's answers recorded in the synchronous
-// run of the same frame; only its duration is emulated.
+// --paced also runs each configuration's asynchronous hand-overs, both kinds
+// (HandOvers::Asynchronous: the producer, the device's thread and a decoder
+// thread; HandOvers::Polled: the producer decodes, and it and the device's
+// thread poll instead of sleeping), against a device held for its modelled
+// time (PacedDevice), and prints each frame's measured wall time beside the
+// modelled overlapped frame of the same kind: a check of the model against
+// the threads that run it. The paced device replays the model backend's
+// answers recorded in the synchronous run of the same frame; only its
+// duration is emulated.
 //
 // Several --first-batch-cells values are timed side by side: every frame runs
 // each configuration in turn (in a rotating order), so that the machine's
@@ -33,10 +35,9 @@
 #include <new>
 #include <memory>
 #include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
-
-#include <sys/prctl.h>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -45,6 +46,7 @@
 #include "backend.hpp"
 #include "broad_phase.hpp"
 #include "exact_pairs.hpp"
+#include "paced_device.hpp"
 #include "rtl_backend.hpp"
 #include "scene.hpp"
 #include "timeline.hpp"
@@ -71,108 +73,20 @@ double median(std::vector<double> v) {
   return (v[(v.size() - 1) / 2] + v[v.size() / 2]) / 2;
 }
 
-// Each hand-over's answer, recorded from the synchronous run of a frame and
-// replayed in the same order by the paced run of the same frame (the
-// asynchronous hand-overs are the synchronous ones: the tests prove it).
-using Recording = std::vector<bpaccel::BatchResult>;
-
-// Appends one hand-over's own answer to what Backend::runBatch fills.
-void append(const bpaccel::BatchResult& answer, std::vector<bpaccel::Pair>& out, std::vector<std::size_t>& cellEnds,
-            bpaccel::RunStats& stats) {
-  const std::size_t base = out.size();
-  out.insert(out.end(), answer.pairs.begin(), answer.pairs.end());
-  for (const std::size_t end : answer.cellEnds) cellEnds.push_back(base + end);
-  stats += answer.stats;
+// Hand-over h's median span over the frames, in us: " from-to" each.
+std::string medianSpans(const std::vector<std::vector<std::pair<double, double>>>& spans) {
+  std::string line;
+  for (std::size_t h = 0; h < spans.front().size(); ++h) {
+    std::vector<double> from, to;
+    for (const auto& frame : spans)
+      if (h < frame.size()) {
+        from.push_back(frame[h].first);
+        to.push_back(frame[h].second);
+      }
+    line += fmt::format(" {:.0f}-{:.0f}", median(from) * 1e6, median(to) * 1e6);
+  }
+  return line;
 }
-
-// The synchronous run's device: the model backend, its answers recorded.
-class RecordingDevice final : public bpaccel::Backend {
- public:
-  RecordingDevice(std::unique_ptr<bpaccel::Backend> inner, Recording& recording)
-      : inner_(std::move(inner)), recording_(recording) {}
-  std::string name() const override { return inner_->name(); }
-  std::size_t capacity() const override { return inner_->capacity(); }
-  unsigned keyWidth() const override { return inner_->keyWidth(); }
-  bool bipartite() const override { return inner_->bipartite(); }
-  void run(std::span<const bpaccel::KeyBox>, std::vector<bpaccel::Pair>&, bpaccel::RunStats&) override {
-    throw std::logic_error("frame_timing: the recorded device takes batches only");
-  }
-  void runBatch(std::span<const std::span<const bpaccel::KeyBox>> cells, std::span<const std::size_t> splits,
-                std::vector<bpaccel::Pair>& out, std::vector<std::size_t>& cellEnds,
-                bpaccel::RunStats& stats) override {
-    bpaccel::BatchResult r;  // this hand-over's own: its cell ends count from 0
-    inner_->runBatch(cells, splits, r.pairs, r.cellEnds, r.stats);
-    append(r, out, cellEnds, stats);
-    recording_.push_back(std::move(r));
-  }
-
- private:
-  std::unique_ptr<bpaccel::Backend> inner_;
-  Recording& recording_;
-};
-
-// A device that takes its modelled time and no more: it answers each
-// hand-over with the recorded answer (so simulating the device costs this
-// thread nothing: the model backend's own all-pairs work would take longer
-// than the device it models) once a command's latency, the load, the run
-// (or the results on the link, if longer) and a completion's latency have
-// passed since the hand-over reached it (handOverTimes, the model's own
-// parts). It holds the device through the completion's latency, which the
-// model overlaps with the next hand-over: 1 us a hand-over more than the model.
-class PacedDevice final : public bpaccel::Backend {
- public:
-  /// `recorded`: the device whose answers `recording` holds (its capacity, key width and runs are this one's).
-  PacedDevice(const Recording& recording, const bpaccel::Backend& recorded, const bpaccel::PipelineModel& model)
-      : recording_(recording), recorded_(recorded), model_(model) {
-    prctl(PR_SET_TIMERSLACK, 1UL);  // this thread's sleeps end on time, not up to 50 us late
-  }
-  std::string name() const override { return "paced replay"; }
-  std::size_t capacity() const override { return recorded_.capacity(); }
-  unsigned keyWidth() const override { return recorded_.keyWidth(); }
-  bool bipartite() const override { return recorded_.bipartite(); }
-  void run(std::span<const bpaccel::KeyBox>, std::vector<bpaccel::Pair>&, bpaccel::RunStats&) override {
-    throw std::logic_error("frame_timing: the paced device takes batches only");
-  }
-  /// Called before each frame: its hand-overs replay the recording from the start.
-  void rewind(Clock::time_point frameStart) {
-    next_ = 0;
-    frameStart_ = frameStart;
-  }
-  // Read once a frame has ended. Per hand-over of each frame so far: when it
-  // reached the device and when the device answered (s from the frame's
-  // start); and how late it answered, all frames together.
-  std::vector<std::vector<std::pair<double, double>>> spans;
-  std::vector<double> lateSeconds;
-  void runBatch(std::span<const std::span<const bpaccel::KeyBox>> cells, std::span<const std::size_t>,
-                std::vector<bpaccel::Pair>& out, std::vector<std::size_t>& cellEnds,
-                bpaccel::RunStats& stats) override {
-    const auto reached = Clock::now();
-    if (next_ >= recording_.size() || recording_[next_].cellEnds.size() != cells.size())
-      throw std::logic_error("frame_timing: the paced run's hand-overs differ from the recorded ones");
-    const bpaccel::BatchResult& r = recording_[next_++];
-    append(r, out, cellEnds, stats);
-    const auto t = bpaccel::handOverTimes(r.stats, model_);
-    const double hold = 2 * model_.latencySeconds + t.loadSeconds + std::max(t.computeSeconds, t.resultsSeconds);
-    const auto until = reached + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(hold));
-    // A sleep ends about 15-20 us late here: sleep to near the end, then spin.
-    std::this_thread::sleep_until(until - std::chrono::microseconds(kSpinMicroseconds));
-    while (Clock::now() < until) {
-    }
-    const auto answered = Clock::now();
-    lateSeconds.push_back(std::chrono::duration<double>(answered - until).count());
-    if (next_ == 1) spans.emplace_back();
-    spans.back().emplace_back(std::chrono::duration<double>(reached - frameStart_).count(),
-                              std::chrono::duration<double>(answered - frameStart_).count());
-  }
-
- private:
-  static constexpr int kSpinMicroseconds = 30;
-  const Recording& recording_;
-  const bpaccel::Backend& recorded_;
-  bpaccel::PipelineModel model_;
-  std::size_t next_ = 0;
-  Clock::time_point frameStart_;
-};
 
 }  // namespace
 
@@ -242,11 +156,20 @@ int main(int argc, char** argv) {
     std::vector<double> host, convert, part, cells, decode, pipelined;
     std::vector<double> allocations;  // after the first pass
     unsigned keyWidth = 32;
-    // --paced: the same configuration's asynchronous hand-overs on a paced device.
-    std::unique_ptr<bpaccel::BroadPhase> pacedPhase;
-    std::unique_ptr<Recording> recording = std::make_unique<Recording>();  // the synchronous run's answers
-    PacedDevice* pacedDevice = nullptr;  // owned by pacedPhase's device thread
-    std::vector<double> pacedWall, pacedLastReady, lastReady, pacedWaits, pacedDecode;
+    std::vector<double> pipelinedPolled;  // the modelled overlapped frame with the producer decoding
+    std::vector<double> lastReady;        // when the synchronous run's last batch was ready
+    // Per frame, the modelled device's span of each hand-over (producer decoding), s from the frame's start.
+    std::vector<std::vector<std::pair<double, double>>> modelledSpans;
+    // --paced: the same configuration's asynchronous hand-overs on a paced device, of each kind.
+    struct Paced {
+      bpaccel::HandOvers handOvers;
+      std::unique_ptr<bpaccel::BroadPhase> phase;
+      bpaccel::PacedDevice* device = nullptr;  // owned by the phase's device thread
+      std::vector<double> wall, lastReady, waits, decode;
+    };
+    std::vector<std::unique_ptr<Paced>> paced;
+    // The synchronous run's answers.
+    std::unique_ptr<bpaccel::AnswerRecording> recording = std::make_unique<bpaccel::AnswerRecording>();
   };
   bpaccel::PipelineModel model;  // the benchmark's link model (--link-gbytes-per-s 4, --link-latency-us 1)
   model.clockHz = clockMHz * 1e6;
@@ -261,22 +184,27 @@ int main(int argc, char** argv) {
       Timed t;
       t.keyWidth = keyWidth;
       t.backend = makeBackend(keyWidth);
-      if (paced) t.backend = std::make_unique<RecordingDevice>(std::move(t.backend), *t.recording);
+      if (paced) t.backend = std::make_unique<bpaccel::RecordingDevice>(std::move(t.backend), *t.recording);
       t.phase = std::make_unique<bpaccel::BroadPhase>(*t.backend, cellSize, cellsPerBatch,
                                                       bpaccel::parsePartitionKind(partition));
       t.phase->setFirstBatchCells(first);
       if (paced) {
         bpaccel::PipelineModel deviceModel = model;
         deviceModel.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(keyWidth));
-        // Built on the device's thread while the constructor waits: the pointer is set when it returns.
-        t.pacedPhase = std::make_unique<bpaccel::BroadPhase>(
-            [&t, deviceModel] {
-              auto device = std::make_unique<PacedDevice>(*t.recording, *t.backend, deviceModel);
-              t.pacedDevice = device.get();
-              return device;
-            },
-            cellSize, 1, cellsPerBatch, bpaccel::parsePartitionKind(partition), bpaccel::HandOvers::Asynchronous);
-        t.pacedPhase->setFirstBatchCells(first);
+        for (const auto kind : {bpaccel::HandOvers::Asynchronous, bpaccel::HandOvers::Polled}) {
+          auto run = std::make_unique<Timed::Paced>();
+          run->handOvers = kind;
+          // Built on the device's thread while the constructor waits: the pointer is set when it returns.
+          run->phase = std::make_unique<bpaccel::BroadPhase>(
+              [&t, &run, deviceModel] {
+                auto device = std::make_unique<bpaccel::PacedDevice>(*t.recording, *t.backend, deviceModel);
+                run->device = device.get();
+                return device;
+              },
+              cellSize, 1, cellsPerBatch, bpaccel::parsePartitionKind(partition), kind);
+          run->phase->setFirstBatchCells(first);
+          t.paced.push_back(std::move(run));
+        }
       }
       timed.push_back(std::move(t));
     }
@@ -308,25 +236,33 @@ int main(int argc, char** argv) {
         // The link carries the device's keys.
         model.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(t.keyWidth));
         t.pipelined.push_back(bpaccel::modelPipeline(t.phase->runs(), hostSeconds, model).frameSeconds);
+        bpaccel::PipelineModel polled = model;
+        polled.decodeOnProducer = true;
+        const auto polledTimeline = bpaccel::modelPipeline(t.phase->runs(), hostSeconds, polled);
+        t.pipelinedPolled.push_back(polledTimeline.frameSeconds);
+        t.modelledSpans.emplace_back();
+        for (const auto& span : polledTimeline.device) t.modelledSpans.back().emplace_back(span.start, span.end);
+        t.lastReady.push_back(t.phase->runs().empty() ? 0 : t.phase->runs().back().readySeconds);
         std::sort(pairs.begin(), pairs.end());
         if (pairs != exact[f]) {
           fmt::print(stderr, "frame_timing: frame {} pass {}: {} pairs, the exact set has {}\n", f, p, pairs.size(),
                      exact[f].size());
           return 1;
         }
-        if (t.pacedPhase) {
+        for (std::size_t q = 0; q < t.paced.size(); ++q) {  // the kinds in a rotating order too
+          Timed::Paced& run = *t.paced[(q + turn) % t.paced.size()];
           for (std::size_t b = 0; b < flood.size(); b += 64) sink += static_cast<unsigned char>(++flood[b]);
+          run.phase->awakenDevices();  // as the bench does: the emulated device, like a card, needs no waking
           const auto p0 = Clock::now();
-          t.pacedDevice->rewind(p0);
-          t.pacedPhase->findPairs(recorded[f], pairs);
-          t.pacedWall.push_back(std::chrono::duration<double>(Clock::now() - p0).count());
-          // When the producer handed its last batch over, in both runs (waits for room left out).
-          t.pacedLastReady.push_back(t.pacedPhase->runs().back().readySeconds);
-          t.lastReady.push_back(t.phase->runs().back().readySeconds);
-          t.pacedWaits.push_back(t.pacedPhase->times().backendSeconds);
+          run.device->rewind(p0);
+          run.phase->findPairs(recorded[f], pairs);
+          run.wall.push_back(std::chrono::duration<double>(Clock::now() - p0).count());
+          // When the producer handed its last batch over (waits for room left out).
+          run.lastReady.push_back(run.phase->runs().back().readySeconds);
+          run.waits.push_back(run.phase->times().backendSeconds);
           double decoding = 0;
-          for (const auto& r : t.pacedPhase->runs()) decoding += r.decodeSeconds;
-          t.pacedDecode.push_back(decoding);
+          for (const auto& r : run.phase->runs()) decoding += r.decodeSeconds;
+          run.decode.push_back(decoding);
           std::sort(pairs.begin(), pairs.end());
           if (pairs != exact[f]) {
             fmt::print(stderr, "frame_timing: paced frame {} pass {}: {} pairs, the exact set has {}\n", f, p,
@@ -345,41 +281,36 @@ int main(int argc, char** argv) {
     const Timed& t = timed[k];
     const auto& stats = t.phase->stats();
     fmt::print("key_width {} first_batch_cells {} host_us {:.1f} convert_us {:.1f} partition_us {:.1f} "
-               "cells_host_us {:.1f} (decode_us {:.1f}) pipelined_us_modelled {:.1f} at {} MHz; pairs {} hits {} "
-               "runs {} batches {} device_cycles {} allocations/frame {}\n",
+               "cells_host_us {:.1f} (decode_us {:.1f}) pipelined_us_modelled {:.1f} (producer decoding: {:.1f}) "
+               "at {} MHz; pairs {} hits {} runs {} batches {} device_cycles {} allocations/frame {}\n",
                t.keyWidth, t.phase->firstBatchCells(), us(t.host), us(t.convert), us(t.part), us(t.cells), us(t.decode),
-               us(t.pipelined), clockMHz, pairs.size(), stats.hits, stats.runs, stats.batches, stats.deviceCycles(),
-               median(t.allocations));
-    if (t.pacedPhase) {
-      const auto& late = t.pacedDevice->lateSeconds;
+               us(t.pipelined), us(t.pipelinedPolled), clockMHz, pairs.size(), stats.hits, stats.runs, stats.batches,
+               stats.deviceCycles(), median(t.allocations));
+    for (const auto& run : t.paced) {
+      const bool polled = run->handOvers == bpaccel::HandOvers::Polled;
+      const std::string kind = polled ? "paced, polled" : "paced, decoder thread";
+      const auto& modelled = polled ? t.pipelinedPolled : t.pipelined;
+      const auto& late = run->device->lateSeconds();
       std::vector<double> ratio;
-      for (std::size_t i = 0; i < t.pacedWall.size(); ++i) ratio.push_back(t.pacedWall[i] / t.pipelined[i]);
-      fmt::print("  paced: asynchronous hand-overs against a device held for its modelled time: frame_us {:.1f} "
-                 "(measured wall time; device emulated), per frame {:.3f}x the modelled overlapped frame; "
-                 "the device answered a median {:.1f} us late (max {:.1f}) over {} hand-overs\n",
-                 us(t.pacedWall), median(ratio), us(late),
+      for (std::size_t i = 0; i < run->wall.size(); ++i) ratio.push_back(run->wall[i] / modelled[i]);
+      fmt::print("  {}: asynchronous hand-overs against a device held for its modelled time: frame_us {:.1f} "
+                 "(measured wall time; device emulated), per frame {:.3f}x the modelled overlapped frame of this "
+                 "kind; the device answered a median {:.1f} us late (max {:.1f}) over {} hand-overs\n",
+                 kind, us(run->wall), median(ratio), us(late),
                  late.empty() ? 0.0 : *std::max_element(late.begin(), late.end()) * 1e6, late.size());
-      fmt::print("  paced: the producer handed its last batch over at {:.1f} us (its waits left out; {:.1f} us in "
+      fmt::print("  {}: the producer handed its last batch over at {:.1f} us (its waits left out; {:.1f} us in "
                  "the synchronous run, which decodes in between)\n",
-                 us(t.pacedLastReady), us(t.lastReady));
-      fmt::print("  paced: the producer waited {:.1f} us a frame for room and for the last decode; the decoder "
-                 "thread decoded for {:.1f} us a frame\n",
-                 us(t.pacedWaits), us(t.pacedDecode));
+                 kind, us(run->lastReady), us(t.lastReady));
+      fmt::print("  {}: the producer waited {:.1f} us a frame for room and for the last answers; decoding took "
+                 "{:.1f} us a frame ({})\n",
+                 kind, us(run->waits), us(run->decode), polled ? "on the producer" : "on the decoder thread");
+      if (!run->device->spans().empty())
+        fmt::print("  {}: the device's hand-overs, median us from the frame's start:{}\n", kind,
+                   medianSpans(run->device->spans()));
     }
-    if (t.pacedPhase && !t.pacedDevice->spans.empty()) {  // hand-over h's median span over the frames
-      const auto& spans = t.pacedDevice->spans;
-      std::string line;
-      for (std::size_t h = 0; h < spans.front().size(); ++h) {
-        std::vector<double> from, to;
-        for (const auto& frame : spans)
-          if (h < frame.size()) {
-            from.push_back(frame[h].first);
-            to.push_back(frame[h].second);
-          }
-        line += fmt::format(" {:.0f}-{:.0f}", median(from) * 1e6, median(to) * 1e6);
-      }
-      fmt::print("  paced: the device's hand-overs, median us from the frame's start:{}\n", line);
-    }
+    if (!t.modelledSpans.empty() && !t.modelledSpans.front().empty())
+      fmt::print("  MODELLED (producer decoding): the device's hand-overs, median us from the frame's start:{}\n",
+                 medianSpans(t.modelledSpans));
     if (k > 0) {  // paired with the first configuration, frame by frame
       std::vector<double> ratio;
       for (std::size_t i = 0; i < t.pipelined.size(); ++i) ratio.push_back(t.pipelined[i] / timed[0].pipelined[i]);
