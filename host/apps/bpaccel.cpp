@@ -106,7 +106,7 @@ int runPairs(const std::string& input, const std::string& backendName, const std
 std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, double clockMHz,
                                                   const std::string& fpgaReport, double linkGBytesPerSecond,
                                                   double linkLatencyUs, std::size_t cellsPerBatch,
-                                                  std::size_t firstBatchCells) {
+                                                  std::size_t firstBatchCells, bool paced) {
   auto device = std::make_shared<bpaccel::DeviceConfig>();
   device->backend = backend;
   device->makeBackend = [backend] { return makeBackend(backend); };
@@ -129,6 +129,7 @@ std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, do
   device->link.latencySecondsPerRun = linkLatencyUs * 1e-6;
   device->cellsPerBatch = cellsPerBatch;
   device->firstBatchCells = firstBatchCells;
+  device->paced = paced && cellsPerBatch > 1;  // one cell a hand-over has nothing to overlap
   device->hardware["batch_cells"] = BPACCEL_BATCH_CELLS;
   return device;
 }
@@ -230,6 +231,7 @@ int main(int argc, char** argv) {
   // (first hand-overs of 1 to 16 cells did about as well), for about 90 and
   // 240 more load cycles.
   std::size_t firstBatchCells = 4;
+  bool paced = true;
   std::string fpgaReport = bpaccel::fpgaReportPath(BPACCEL_M, BPACCEL_ARCH, BPACCEL_KEY_WIDTH);
   auto* benchCmd = app.add_subcommand(
       "bench", "Bouncing-cube benchmark: Bullet's, FCL's, CGAL's and ODE's broad phases against the accelerator");
@@ -268,6 +270,10 @@ int main(int argc, char** argv) {
                        "Cells of a frame's first hand-over, each next one twice as many up to --cells-per-batch "
                        "(slow start: the device starts before a whole batch is packed)")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  benchCmd->add_flag("--paced,!--no-paced", paced,
+                     "Also time each accelerator frame as its host threads run it (polled asynchronous hand-overs) "
+                     "against a device emulated for its modelled time (needs --cells-per-batch of at least 2)")
+      ->capture_default_str();
   benchCmd->add_option("--whole-step-objects", bench.wholeStepObjects,
                        "Also time full stepSimulation calls with btDbvtBroadphase and bpaccel::Broadphase at this "
                        "object count (0: not)")
@@ -301,7 +307,7 @@ int main(int argc, char** argv) {
   try {
     if (*benchCmd) {
       lineUp.device = makeDevice(benchBackend, clockMHz, fpgaReport, linkGBytesPerSecond, linkLatencyUs,
-                                 cellsPerBatch, firstBatchCells);
+                                 cellsPerBatch, firstBatchCells, paced);
       return runBench(bench, lineUp, benchCells, benchJson);
     }
     if (*sceneCmd) return runScene(sceneConfig, sceneFrames, sceneOut);

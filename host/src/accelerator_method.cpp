@@ -18,12 +18,53 @@ double LinkModel::seconds(const RunStats& s, std::size_t bytesPerBeat, double cl
 
 std::string cellName(const std::optional<std::size_t>& c) { return c ? std::to_string(*c) : "none"; }
 
+namespace {
+
+// The device's backend, recording its answers when the method runs paced.
+std::unique_ptr<Backend> recordedBackend(const DeviceConfig& device, AnswerRecording* recording) {
+  auto backend = device.makeBackend();
+  if (!backend) throw std::invalid_argument("accelerator method: the device config gave no backend");
+  if (!recording) return backend;
+  if (device.cellsPerBatch < 2)
+    throw std::invalid_argument("accelerator method: paced runs need at least two cells per batch");
+  return std::make_unique<RecordingDevice>(std::move(backend), *recording);
+}
+
+}  // namespace
+
 AcceleratorMethod::AcceleratorMethod(std::shared_ptr<const DeviceConfig> device, std::optional<std::size_t> cellSize,
                                      PartitionKind partition)
     : device_(std::move(device)),
-      backend_(device_->makeBackend()),
+      recording_(device_->paced ? std::make_unique<AnswerRecording>() : nullptr),
+      backend_(recordedBackend(*device_, recording_.get())),
       phase_(*backend_, cellSize, device_->cellsPerBatch, partition) {
   if (device_->firstBatchCells) phase_.setFirstBatchCells(device_->firstBatchCells);
+  if (!device_->paced) return;
+  PipelineModel model = pipelineModel();
+  // Built on the device's thread while the constructor waits: the pointer is set when it returns.
+  pacedPhase_ = std::make_unique<BroadPhase>(
+      [this, model] {
+        auto paced = std::make_unique<PacedDevice>(*recording_, *backend_, model);
+        pacedDevice_ = paced.get();
+        return paced;
+      },
+      cellSize, 1, device_->cellsPerBatch, partition, HandOvers::Polled);
+  pacedPhase_->setFirstBatchCells(phase_.firstBatchCells());
+}
+
+// The paced phase's device thread reads the recording and the recorded backend: it goes first.
+AcceleratorMethod::~AcceleratorMethod() { pacedPhase_.reset(); }
+
+void AcceleratorMethod::update(std::span<const Aabb> boxes) {
+  if (recording_) recording_->clear();
+  phase_.findPairs(boxes, pairs_);
+}
+
+PipelineModel AcceleratorMethod::pipelineModel() const {
+  PipelineModel model{device_->clockHz, device_->link.bandwidthBytesPerSecond, device_->link.latencySecondsPerRun,
+                      device_->link.bytesPerBox, static_cast<double>(device_->beatBytes)};
+  model.decodeOnProducer = true;  // the schedule runPaced measures: HandOvers::Polled
+  return model;
 }
 
 FrameTime AcceleratorMethod::frameTime(double measuredSeconds) const {
@@ -33,10 +74,14 @@ FrameTime AcceleratorMethod::frameTime(double measuredSeconds) const {
   p.partitionSeconds = phase_.times().partitionSeconds;
   p.deviceSeconds = static_cast<double>(p.stats.deviceCycles()) / device_->clockHz;
   p.transferSeconds = device_->link.seconds(p.stats, device_->beatBytes, device_->clockHz);
-  const PipelineModel model{device_->clockHz, device_->link.bandwidthBytesPerSecond, device_->link.latencySecondsPerRun,
-                            device_->link.bytesPerBox, static_cast<double>(device_->beatBytes)};
-  p.pipeline = std::make_shared<const FrameTimeline>(modelPipeline(phase_.runs(), p.hostSeconds, model));
+  p.pipeline = std::make_shared<const FrameTimeline>(modelPipeline(phase_.runs(), p.hostSeconds, pipelineModel()));
   return {p.hostSeconds + p.deviceSeconds + p.transferSeconds, p};
+}
+
+void AcceleratorMethod::runPaced(std::span<const Aabb> boxes) {
+  if (!pacedPhase_) throw std::logic_error("accelerator method: built without paced runs");
+  pacedDevice_->rewind(std::chrono::steady_clock::now());
+  pacedPhase_->findPairs(boxes, pairs_);
 }
 
 namespace {

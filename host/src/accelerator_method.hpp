@@ -12,6 +12,7 @@
 
 #include "backend.hpp"
 #include "broad_phase.hpp"
+#include "paced_device.hpp"
 #include "timed_method.hpp"
 
 namespace bpaccel {
@@ -64,23 +65,41 @@ struct DeviceConfig {
   /// Cells of a frame's first hand-over, doubling up to cellsPerBatch
   /// (BroadPhase::setFirstBatchCells); 0: every hand-over holds cellsPerBatch.
   std::size_t firstBatchCells = 0;
+  /// Each frame also runs paced (TimedMethod::runPaced): the host's polled
+  /// asynchronous hand-overs (HandOvers::Polled) against a PacedDevice that
+  /// replays the frame's recorded answers in their modelled time. Needs
+  /// cellsPerBatch of at least 2.
+  bool paced = false;
 };
 
 /// BroadPhase on the device: host part measured, device and link modelled.
+/// With DeviceConfig::paced, the device's answers are recorded in update()
+/// (RecordingDevice) and runPaced() runs the frame again on a second broad
+/// phase with polled asynchronous hand-overs, against a PacedDevice.
 class AcceleratorMethod final : public TimedMethod {
  public:
   AcceleratorMethod(std::shared_ptr<const DeviceConfig> device, std::optional<std::size_t> cellSize,
                     PartitionKind partition = PartitionKind::KdTree);
-  void update(std::span<const Aabb> boxes) override { phase_.findPairs(boxes, pairs_); }
+  ~AcceleratorMethod() override;
+  void update(std::span<const Aabb> boxes) override;
   void pairs(std::vector<Pair>& out) override { out = pairs_; }
   /// Host = measured wall time minus the time spent simulating the device;
   /// device = every busy cycle (loads included) / clock; transfer = LinkModel.
   FrameTime frameTime(double measuredSeconds) const override;
+  bool hasPacedRun() const override { return pacedPhase_ != nullptr; }
+  void readyPacedDevice() override {
+    if (pacedPhase_) pacedPhase_->awakenDevices();
+  }
+  void runPaced(std::span<const Aabb> boxes) override;
 
  private:
+  PipelineModel pipelineModel() const;
   std::shared_ptr<const DeviceConfig> device_;
+  std::unique_ptr<AnswerRecording> recording_;  // with paced runs: the last update's answers
   std::unique_ptr<Backend> backend_;
   BroadPhase phase_;
+  PacedDevice* pacedDevice_ = nullptr;  // owned by pacedPhase_'s device thread
+  std::unique_ptr<BroadPhase> pacedPhase_;
   std::vector<Pair> pairs_;
 };
 

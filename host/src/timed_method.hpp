@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -56,6 +57,18 @@ class TimedMethod {
   /// The frame's time from the measured wall time of update(). Methods with a
   /// modelled device replace the device's simulation by its model here.
   virtual FrameTime frameTime(double measuredSeconds) const { return {measuredSeconds, std::nullopt}; }
+  /// Whether the method has a paced run (runPaced).
+  virtual bool hasPacedRun() const { return false; }
+  /// Untimed, just before runPaced: the emulated device gets ready as a
+  /// card is (its thread awake and polling for the first hand-over).
+  virtual void readyPacedDevice() {}
+  /// A method with a modelled device may run the last update's boxes again
+  /// as its host threads would drive a real device, against a device
+  /// emulated for its modelled time, and leave those pairs for pairs(); the
+  /// caller times it.
+  virtual void runPaced(std::span<const Aabb> /*boxes*/) {
+    throw std::logic_error("this method has no paced run");
+  }
 };
 
 /// What a method gets to build its structure (not timed as a frame).

@@ -65,11 +65,49 @@ class Tampered final : public TimedMethod {
     edit_(out);
   }
   FrameTime frameTime(double s) const override { return inner_->frameTime(s); }
+  bool hasPacedRun() const override { return inner_->hasPacedRun(); }
+  void readyPacedDevice() override { inner_->readyPacedDevice(); }
+  void runPaced(std::span<const Aabb> boxes) override { inner_->runPaced(boxes); }
 
  private:
   std::unique_ptr<TimedMethod> inner_;
   std::function<void(std::vector<Pair>&)> edit_;
 };
+
+// Decorates a method: the pairs of its paced runs only pass through `edit`.
+class TamperedPaced final : public TimedMethod {
+ public:
+  TamperedPaced(std::unique_ptr<TimedMethod> inner, std::function<void(std::vector<Pair>&)> edit)
+      : inner_(std::move(inner)), edit_(std::move(edit)) {}
+  void update(std::span<const Aabb> boxes) override {
+    paced_ = false;
+    inner_->update(boxes);
+  }
+  void pairs(std::vector<Pair>& out) override {
+    inner_->pairs(out);
+    if (paced_) edit_(out);
+  }
+  FrameTime frameTime(double s) const override { return inner_->frameTime(s); }
+  bool hasPacedRun() const override { return inner_->hasPacedRun(); }
+  void readyPacedDevice() override { inner_->readyPacedDevice(); }
+  void runPaced(std::span<const Aabb> boxes) override {
+    paced_ = true;
+    inner_->runPaced(boxes);
+  }
+
+ private:
+  std::unique_ptr<TimedMethod> inner_;
+  std::function<void(std::vector<Pair>&)> edit_;
+  bool paced_ = false;
+};
+
+// The rtl device, batched 8 cells a hand-over, each frame also run paced.
+std::shared_ptr<DeviceConfig> pacedRtlDevice() {
+  auto d = rtlDevice();
+  d->cellsPerBatch = 8;
+  d->paced = true;
+  return d;
+}
 
 std::vector<MethodSpec> tamperedAccelerator(std::function<void(std::vector<Pair>&)> edit) {
   auto specs = acceleratorMethods(rtlDevice(), {16}, 1e8);
@@ -243,6 +281,87 @@ TEST(Benchmark, AnExactMethodThatInventsAPairFailsTheRunWithTheCount) {
     EXPECT_EQ(e.difference().missing, 0u);
     EXPECT_EQ(e.difference().extra, 1u);
   }
+}
+
+TEST(Benchmark, PacedRunsAreTimedValidatedAndReportedBesideTheModelledFrame) {
+  LineUpConfig l;
+  l.cellSizes = {16};
+  l.gridCellSizes = {16};
+  l.device = pacedRtlDevice();
+  const auto j = runQuietly(tinyConfig(), standardLineUp(l), l);
+  std::size_t paced = 0;
+  for (const auto& row : j["rows"]) {
+    for (const auto& m : row["methods"]) {
+      if (m["kind"] != "accelerator") {
+        EXPECT_FALSE(m.contains("paced_frame_ms")) << m["name"];
+        continue;
+      }
+      ASSERT_TRUE(m.contains("paced_frame_ms")) << m["name"];
+      EXPECT_GT(m["paced_frame_ms"]["median"].get<double>(), 0) << m["name"];
+      // It waits for the device it emulates: never less than the device's modelled busy time.
+      EXPECT_GE(m["paced_frame_ms"]["min"].get<double>() * (1 + 1e-9), m["device_ms_modelled"]["min"].get<double>())
+          << m["name"];
+      EXPECT_TRUE(m["paced_acceleration_over_fastest_baseline"].is_number()) << m["name"];
+      ++paced;
+    }
+    EXPECT_TRUE(row["timeline"]["paced_ms"].is_number());
+  }
+  EXPECT_EQ(paced, 4u);  // k-d 16 and grid 16, two rows
+  const std::string table = Benchmark::table(j);
+  EXPECT_NE(table.find("against a device EMULATED for its modelled time"), std::string::npos);
+
+  // Without paced runs, no such figure and no such block.
+  auto unpaced = pacedRtlDevice();
+  unpaced->paced = false;
+  l.device = unpaced;
+  const auto plain = runQuietly(tinyConfig(), standardLineUp(l), l);
+  for (const auto& m : plain["rows"][0]["methods"]) EXPECT_FALSE(m.contains("paced_frame_ms")) << m["name"];
+  EXPECT_EQ(Benchmark::table(plain).find("EMULATED"), std::string::npos);
+}
+
+TEST(Benchmark, APacedRunThatMissesAPairFailsTheRunNamingThePacedRun) {
+  const auto l = tinyLineUp();
+  auto specs = acceleratorMethods(pacedRtlDevice(), {16}, 1e8);
+  auto make = specs[0].make;
+  specs[0].make = [make](const SceneStart& s) {
+    return std::make_unique<TamperedPaced>(make(s), [](std::vector<Pair>& p) {
+      if (!p.empty()) p.pop_back();
+    });
+  };
+  try {
+    runQuietly(tinyConfig(), specs, l);
+    FAIL() << "no ValidationFailure";
+  } catch (const ValidationFailure& e) {
+    EXPECT_EQ(e.method(), "accelerator k-d 16 (paced run)");
+    EXPECT_EQ(e.difference().missing, 1u);
+  }
+}
+
+TEST(AcceleratorMethod, APacedRunFindsTheUpdatesPairsAndNeedsBatches) {
+  const auto boxes = bpaccel::testing::adversarialScenes(1500, 5)[0].second;
+  auto d = std::make_shared<DeviceConfig>();
+  d->makeBackend = [] { return std::make_unique<ModelBackend>(modelOfBuiltHardware()); };
+  d->cellsPerBatch = 8;
+  d->paced = true;
+  AcceleratorMethod method(d, 16, PartitionKind::UniformGrid);
+  ASSERT_TRUE(method.hasPacedRun());
+  std::vector<Pair> serial, paced;
+  for (int frame = 0; frame < 2; ++frame) {
+    method.update(boxes);
+    method.pairs(serial);
+    method.readyPacedDevice();
+    method.runPaced(boxes);
+    method.pairs(paced);
+    EXPECT_EQ(bpaccel::testing::sorted(paced), bpaccel::testing::sorted(serial));
+    EXPECT_EQ(bpaccel::testing::sorted(paced), bpaccel::testing::bruteForce(boxes));
+  }
+  d->paced = false;
+  AcceleratorMethod plain(d, 16);
+  EXPECT_FALSE(plain.hasPacedRun());
+  EXPECT_THROW(plain.runPaced(boxes), std::logic_error);
+  d->paced = true;
+  d->cellsPerBatch = 1;  // one cell a hand-over: nothing to run asynchronously
+  EXPECT_THROW(AcceleratorMethod(d, 16), std::invalid_argument);
 }
 
 TEST(Benchmark, APeerThatMissesPairsIsCountedAndMarkedNotFailed) {
