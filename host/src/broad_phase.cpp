@@ -595,6 +595,7 @@ void BroadPhase::Worker::decodeOldest() {
       break;
     }
     __builtin_ia32_pause();
+    std::this_thread::yield();  // a thread that shares this core runs first
   }
   const auto got = Clock::now();
   backendSeconds += seconds(from, got);
