@@ -581,7 +581,7 @@ std::string Benchmark::table(const nlohmann::json& results) {
     header("Accelerator frame as its host threads run it, ms, and its acceleration over the fastest above: MEASURED "
            "wall time of the polled asynchronous hand-overs (one host thread produces and decodes; the device on a "
            "thread of its own) against a device EMULATED for its modelled time (each frame's answers recorded in its "
-           "serial run, replayed after the modelled load, run and link times); caches emptied before each");
+           "serial run, replayed after the modelled load, run and link times), after every update of the frame");
     for (const auto& name : names) {
       if (kindOf(name) != "accelerator") continue;
       t += pad(name, kName);
