@@ -288,6 +288,25 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
   const double energyStart = scene.kineticEnergy();
   std::mt19937 shuffler(sc.seed);
   std::vector<std::size_t> order = active;
+  // The method's last pairs against this frame's exact set, and how many it
+  // reported more than once (FCL's spatial hash, once per shared cell),
+  // counted apart from extra pairs.
+  struct Checked {
+    SetDifference difference;
+    std::uint64_t duplicates = 0;
+  };
+  const auto checkPairs = [&](TimedMethod& method) {
+    const auto tv = Clock::now();
+    method.pairs(got);
+    std::sort(got.begin(), got.end());
+    const auto unique = std::unique(got.begin(), got.end());
+    Checked c;
+    c.duplicates = static_cast<std::uint64_t>(got.end() - unique);
+    got.erase(unique, got.end());
+    c.difference = compareSorted(got, exact);
+    validationSeconds += since(tv);
+    return c;
+  };
   // A method's paced run (TimedMethod::runPaced) of this frame's boxes,
   // timed and validated like an update.
   const auto timePaced = [&](Entry& e, std::size_t frame) {
@@ -295,14 +314,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
     const auto t0 = Clock::now();
     e.method->runPaced(boxes);
     const double wall = since(t0);
-    const auto tv = Clock::now();
-    e.method->pairs(got);
-    std::sort(got.begin(), got.end());
-    const auto unique = std::unique(got.begin(), got.end());
-    const bool duplicates = unique != got.end();
-    got.erase(unique, got.end());
-    const SetDifference d = compareSorted(got, exact);
-    validationSeconds += since(tv);
+    const auto [d, duplicates] = checkPairs(*e.method);
     if (d.missing || d.extra || duplicates)
       throw ValidationFailure(e.spec->name + " (paced run)", objects, frame, d, exact.size());
     return wall;
@@ -328,15 +340,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
       const double wall = since(t0);
       e.updateSeconds += wall;
       const FrameTime ft = e.method->frameTime(wall);
-      const auto tv = Clock::now();
-      e.method->pairs(got);
-      std::sort(got.begin(), got.end());
-      // A pair reported twice (FCL's spatial hash, once per shared cell) is counted apart from extra pairs.
-      const auto unique = std::unique(got.begin(), got.end());
-      const auto duplicates = static_cast<std::uint64_t>(got.end() - unique);
-      got.erase(unique, got.end());
-      const SetDifference d = compareSorted(got, exact);
-      validationSeconds += since(tv);
+      const auto [d, duplicates] = checkPairs(*e.method);
       e.missing += d.missing;
       e.extra += d.extra;
       e.duplicates += duplicates;
@@ -516,6 +520,18 @@ std::string Benchmark::table(const nlohmann::json& results) {
       if (const auto* m = findMethod(r, name)) return (*m)["kind"].get<std::string>();
     return std::string();
   };
+  // One line per accelerator method: `cell` of its JSON entry in each row ("-" where it has none).
+  const auto acceleratorRows = [&](const auto& cell) {
+    for (const auto& name : names) {
+      if (kindOf(name) != "accelerator") continue;
+      t += pad(name, kName);
+      for (const auto& r : rows) {
+        const auto* m = findMethod(r, name);
+        t += fmt::format("{:>16}", m ? cell(*m) : std::string("-"));
+      }
+      t += "\n";
+    }
+  };
   const auto isOurs = [&](const std::string& name) {
     const auto k = kindOf(name);
     return k == "accelerator" || k == "cpu";
@@ -560,19 +576,12 @@ std::string Benchmark::table(const nlohmann::json& results) {
                      "host's polled asynchronous hand-overs (one host thread produces and decodes, at most {} "
                      "batches out) applied to the same frames' measured host work of the serial runs above",
                      kBatchesInFlight));
-  for (const auto& name : names) {
-    if (kindOf(name) != "accelerator") continue;
-    t += pad(name, kName);
-    for (const auto& r : rows) {
-      const auto* m = findMethod(r, name);
-      if (!m || m->contains("skipped") || !m->contains("pipelined_frame_ms_modelled") ||
-          (*m)["pipelined_frame_ms_modelled"].is_null())
-        t += fmt::format("{:>16}", "-");
-      else
-        t += fmt::format("{:>16.4f}", (*m)["pipelined_frame_ms_modelled"]["median"].get<double>());
-    }
-    t += "\n";
-  }
+  acceleratorRows([](const nlohmann::json& m) -> std::string {
+    if (m.contains("skipped") || !m.contains("pipelined_frame_ms_modelled") ||
+        m["pipelined_frame_ms_modelled"].is_null())
+      return "-";
+    return fmt::format("{:.4f}", m["pipelined_frame_ms_modelled"]["median"].get<double>());
+  });
 
   bool anyPaced = false;
   for (const auto& r : rows)
@@ -582,21 +591,12 @@ std::string Benchmark::table(const nlohmann::json& results) {
            "wall time of the polled asynchronous hand-overs (one host thread produces and decodes; the device on a "
            "thread of its own) against a device EMULATED for its modelled time (each frame's answers recorded in its "
            "serial run, replayed after the modelled load, run and link times), after every update of the frame");
-    for (const auto& name : names) {
-      if (kindOf(name) != "accelerator") continue;
-      t += pad(name, kName);
-      for (const auto& r : rows) {
-        const auto* m = findMethod(r, name);
-        if (!m || !m->contains("paced_frame_ms"))
-          t += fmt::format("{:>16}", "-");
-        else if ((*m)["paced_acceleration_over_fastest_baseline"].is_null())
-          t += fmt::format("{:>16.4f}", (*m)["paced_frame_ms"]["median"].get<double>());
-        else
-          t += fmt::format("{:>16}", fmt::format("{:.4f} ({:.1f}x)", (*m)["paced_frame_ms"]["median"].get<double>(),
-                                                 (*m)["paced_acceleration_over_fastest_baseline"].get<double>()));
-      }
-      t += "\n";
-    }
+    acceleratorRows([](const nlohmann::json& m) -> std::string {
+      if (!m.contains("paced_frame_ms")) return "-";
+      const double ms = m["paced_frame_ms"]["median"].get<double>();
+      const auto& over = m["paced_acceleration_over_fastest_baseline"];
+      return over.is_null() ? fmt::format("{:.4f}", ms) : fmt::format("{:.4f} ({:.1f}x)", ms, over.get<double>());
+    });
   }
 
   const auto accelerationBlock = [&](const std::string& title, const auto& baselineOf) {
