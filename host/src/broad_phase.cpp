@@ -5,7 +5,6 @@
 #include <future>
 #include <numeric>
 #include <stdexcept>
-#include <thread>
 #include <utility>
 
 #include <fmt/format.h>
@@ -125,6 +124,12 @@ struct BroadPhase::Worker {
   void finish();  // flush, then (asynchronous) wait until every batch handed over is decoded
   void handOverAsynchronously(std::span<const std::span<const KeyBox>> toDevice);
   void handOverPolled(std::span<const std::span<const KeyBox>> toDevice);
+  // Asynchronous and Polled: hands the batch being filled over to the device
+  // in the next free slot, with its record, and takes that slot's storage.
+  HandedOver& submitFilling(std::span<const std::span<const KeyBox>> toDevice, const RunRecord& record);
+  // Decodes a hand-over's answer, waiting for it (its failure rethrown), and records it.
+  void decodeAnswer(HandedOver& slot);
+  bool polled() const { return async && !decoder; }
   // Polled: the oldest hand-over not yet decoded, polled for until it has
   // arrived; then decoded (its failure rethrown).
   void decodeOldest();
@@ -378,7 +383,7 @@ void BroadPhase::Worker::startFrame(Clock::time_point start) {
     } catch (...) {
     }
   }
-  if (async && !decoder) {
+  if (polled()) {
     abandonOutstanding();
     async->wake();  // polling by the time the partition has the first batch
   }
@@ -528,10 +533,10 @@ void BroadPhase::Worker::flush() {
     filling.clear();
     return;
   }
-  if (decoder)
-    handOverAsynchronously(toDevice);
-  else
+  if (polled())
     handOverPolled(toDevice);
+  else
+    handOverAsynchronously(toDevice);
 }
 
 // The batch goes to the device and its decoding to the decoder thread, which
@@ -549,6 +554,12 @@ void BroadPhase::Worker::handOverAsynchronously(std::span<const std::span<const 
   record.readySeconds = seconds(frameStart, ready) - backendSeconds;
   decoder->waitForRoom();
   backendSeconds += seconds(ready, Clock::now());
+  HandedOver& slot = submitFilling(toDevice, record);
+  decoder->post([this, &slot] { decodeAnswer(slot); });
+}
+
+BroadPhase::Worker::HandedOver& BroadPhase::Worker::submitFilling(std::span<const std::span<const KeyBox>> toDevice,
+                                                                  const RunRecord& record) {
   HandedOver& slot = handedOver[handOversThisFrame++ % kBatchesInFlight];
   slot.result = async->submit(toDevice, filling.splits);
   // Swapping keeps the vectors' storage, so the spans the device holds stay
@@ -556,15 +567,17 @@ void BroadPhase::Worker::handOverAsynchronously(std::span<const std::span<const 
   std::swap(filling, slot.batch);
   filling.clear();
   slot.record = record;
-  decoder->post([this, &slot] {
-    BatchResult result = slot.result.get();  // rethrows the device's failure
-    const auto got = Clock::now();
-    stats += result.stats;
-    decodeBatch(slot.batch, result.pairs, result.cellEnds);
-    slot.record.stats = result.stats;
-    slot.record.decodeSeconds = seconds(got, Clock::now());
-    runs.push_back(slot.record);
-  });
+  return slot;
+}
+
+void BroadPhase::Worker::decodeAnswer(HandedOver& slot) {
+  BatchResult result = slot.result.get();  // rethrows the device's failure
+  const auto got = Clock::now();
+  stats += result.stats;
+  decodeBatch(slot.batch, result.pairs, result.cellEnds);
+  slot.record.stats = result.stats;
+  slot.record.decodeSeconds = seconds(got, Clock::now());
+  runs.push_back(slot.record);
 }
 
 // The batch goes to the device, and the answers that have arrived are
@@ -575,11 +588,7 @@ void BroadPhase::Worker::handOverPolled(std::span<const std::span<const KeyBox>>
   RunRecord record;
   record.readySeconds = seconds(frameStart, Clock::now()) - backendSeconds;
   if (handOversThisFrame - decodedThisFrame == kBatchesInFlight) decodeOldest();
-  HandedOver& slot = handedOver[handOversThisFrame++ % kBatchesInFlight];
-  slot.result = async->submit(toDevice, filling.splits);
-  std::swap(filling, slot.batch);  // as handOverAsynchronously
-  filling.clear();
-  slot.record = record;
+  submitFilling(toDevice, record);
   decodeArrived();
 }
 
@@ -594,18 +603,11 @@ void BroadPhase::Worker::decodeOldest() {
       slot.result.wait();
       break;
     }
-    __builtin_ia32_pause();
-    std::this_thread::yield();  // a thread that shares this core runs first
+    pollPause();
   }
-  const auto got = Clock::now();
-  backendSeconds += seconds(from, got);
+  backendSeconds += seconds(from, Clock::now());
   ++decodedThisFrame;  // first: a failure leaves the next one the oldest
-  BatchResult result = slot.result.get();  // rethrows the device's failure
-  stats += result.stats;
-  decodeBatch(slot.batch, result.pairs, result.cellEnds);
-  slot.record.stats = result.stats;
-  slot.record.decodeSeconds = seconds(got, Clock::now());
-  runs.push_back(slot.record);
+  decodeAnswer(slot);
 }
 
 void BroadPhase::Worker::decodeArrived() {
@@ -624,7 +626,7 @@ void BroadPhase::Worker::abandonOutstanding() {
 
 void BroadPhase::Worker::finish() {
   flush();
-  if (async && !decoder) {
+  if (polled()) {
     while (decodedThisFrame < handOversThisFrame) decodeOldest();
     return;
   }

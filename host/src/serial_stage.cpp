@@ -52,8 +52,7 @@ void SerialStage::serve(std::stop_token stop) {
       const auto until = std::chrono::steady_clock::now() + spinBeforeSleep_;
       while (queued_.load(std::memory_order_acquire) == 0 && !stop.stop_requested() &&
              std::chrono::steady_clock::now() < until) {
-        __builtin_ia32_pause();
-        std::this_thread::yield();  // a thread that shares this core runs first
+        pollPause();
       }
     }
     std::function<void()> task;
