@@ -25,8 +25,6 @@ std::unique_ptr<Backend> recordedBackend(const DeviceConfig& device, AnswerRecor
   auto backend = device.makeBackend();
   if (!backend) throw std::invalid_argument("accelerator method: the device config gave no backend");
   if (!recording) return backend;
-  if (device.cellsPerBatch < 2)
-    throw std::invalid_argument("accelerator method: paced runs need at least two cells per batch");
   return std::make_unique<RecordingDevice>(std::move(backend), *recording);
 }
 
@@ -39,21 +37,11 @@ AcceleratorMethod::AcceleratorMethod(std::shared_ptr<const DeviceConfig> device,
       backend_(recordedBackend(*device_, recording_.get())),
       phase_(*backend_, cellSize, device_->cellsPerBatch, partition) {
   if (device_->firstBatchCells) phase_.setFirstBatchCells(device_->firstBatchCells);
-  if (!device_->paced) return;
-  PipelineModel model = pipelineModel();
-  // Built on the device's thread while the constructor waits: the pointer is set when it returns.
-  pacedPhase_ = std::make_unique<BroadPhase>(
-      [this, model] {
-        auto paced = std::make_unique<PacedDevice>(*recording_, *backend_, model);
-        pacedDevice_ = paced.get();
-        return paced;
-      },
-      cellSize, 1, device_->cellsPerBatch, partition, HandOvers::Polled);
-  pacedPhase_->setFirstBatchCells(phase_.firstBatchCells());
+  // Its batches need at least two cells (BroadPhase refuses fewer).
+  if (device_->paced)
+    pacedPhase_ = std::make_unique<PacedBroadPhase>(*recording_, *backend_, pipelineModel(), cellSize,
+                                                    device_->cellsPerBatch, phase_.firstBatchCells(), partition);
 }
-
-// The paced phase's device thread reads the recording and the recorded backend: it goes first.
-AcceleratorMethod::~AcceleratorMethod() { pacedPhase_.reset(); }
 
 void AcceleratorMethod::update(std::span<const Aabb> boxes) {
   if (recording_) recording_->clear();
@@ -80,7 +68,6 @@ FrameTime AcceleratorMethod::frameTime(double measuredSeconds) const {
 
 void AcceleratorMethod::runPaced(std::span<const Aabb> boxes) {
   if (!pacedPhase_) throw std::logic_error("accelerator method: built without paced runs");
-  pacedDevice_->rewind(std::chrono::steady_clock::now());
   pacedPhase_->findPairs(boxes, pairs_);
 }
 

@@ -80,7 +80,6 @@ class AcceleratorMethod final : public TimedMethod {
  public:
   AcceleratorMethod(std::shared_ptr<const DeviceConfig> device, std::optional<std::size_t> cellSize,
                     PartitionKind partition = PartitionKind::KdTree);
-  ~AcceleratorMethod() override;
   void update(std::span<const Aabb> boxes) override;
   void pairs(std::vector<Pair>& out) override { out = pairs_; }
   /// Host = measured wall time minus the time spent simulating the device;
@@ -88,7 +87,7 @@ class AcceleratorMethod final : public TimedMethod {
   FrameTime frameTime(double measuredSeconds) const override;
   bool hasPacedRun() const override { return pacedPhase_ != nullptr; }
   void readyPacedDevice() override {
-    if (pacedPhase_) pacedPhase_->awakenDevices();
+    if (pacedPhase_) pacedPhase_->awakenDevice();
   }
   void runPaced(std::span<const Aabb> boxes) override;
 
@@ -98,8 +97,8 @@ class AcceleratorMethod final : public TimedMethod {
   std::unique_ptr<AnswerRecording> recording_;  // with paced runs: the last update's answers
   std::unique_ptr<Backend> backend_;
   BroadPhase phase_;
-  PacedDevice* pacedDevice_ = nullptr;  // owned by pacedPhase_'s device thread
-  std::unique_ptr<BroadPhase> pacedPhase_;
+  // After the recording and the recorded backend, which its device thread reads: it goes first.
+  std::unique_ptr<PacedBroadPhase> pacedPhase_;
   std::vector<Pair> pairs_;
 };
 

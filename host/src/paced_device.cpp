@@ -73,4 +73,24 @@ void PacedDevice::runBatch(std::span<const std::span<const KeyBox>> cells, std::
   spans_.back().emplace_back(seconds(reached - frameStart_), seconds(answered - frameStart_));
 }
 
+PacedBroadPhase::PacedBroadPhase(const AnswerRecording& recording, const Backend& recorded,
+                                 const PipelineModel& model, std::optional<std::size_t> cellSize,
+                                 std::size_t cellsPerBatch, std::size_t firstBatchCells, PartitionKind partition,
+                                 HandOvers handOvers) {
+  // Built on the device's thread while the constructor waits: the pointer is set when it returns.
+  phase_ = std::make_unique<BroadPhase>(
+      [&] {
+        auto device = std::make_unique<PacedDevice>(recording, recorded, model);
+        device_ = device.get();
+        return device;
+      },
+      cellSize, 1, cellsPerBatch, partition, handOvers);
+  phase_->setFirstBatchCells(firstBatchCells);
+}
+
+void PacedBroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) {
+  device_->rewind(PacedDevice::Clock::now());
+  phase_->findPairs(boxes, out);
+}
+
 }  // namespace bpaccel

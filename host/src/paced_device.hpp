@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -11,6 +12,7 @@
 
 #include "async_backend.hpp"
 #include "backend.hpp"
+#include "broad_phase.hpp"
 #include "timeline.hpp"
 
 namespace bpaccel {
@@ -83,6 +85,30 @@ class PacedDevice final : public Backend {
   Clock::time_point frameStart_;
   std::vector<std::vector<std::pair<double, double>>> spans_;
   std::vector<double> lateSeconds_;
+};
+
+/// A broad phase whose batches go, with asynchronous hand-overs of kind
+/// `handOvers`, to a PacedDevice that replays `recording`: each frame it runs
+/// the boxes of the frame whose answers were last recorded, on the host's
+/// threads as they would drive a real device, with the device's durations
+/// emulated. `recorded` is the device that recorded them; the partition,
+/// cell size and batches must be the recording run's.
+class PacedBroadPhase {
+ public:
+  PacedBroadPhase(const AnswerRecording& recording, const Backend& recorded, const PipelineModel& model,
+                  std::optional<std::size_t> cellSize, std::size_t cellsPerBatch, std::size_t firstBatchCells,
+                  PartitionKind partition, HandOvers handOvers = HandOvers::Polled);
+  /// Untimed, before a frame: the emulated device awake, as a card needs no
+  /// waking (BroadPhase::awakenDevices).
+  void awakenDevice() { phase_->awakenDevices(); }
+  /// The recorded frame again: the device replays the recording from its start.
+  void findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out);
+  const BroadPhase& phase() const { return *phase_; }
+  const PacedDevice& device() const { return *device_; }
+
+ private:
+  PacedDevice* device_ = nullptr;  // owned by phase_'s device thread
+  std::unique_ptr<BroadPhase> phase_;
 };
 
 }  // namespace bpaccel

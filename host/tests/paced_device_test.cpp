@@ -105,30 +105,24 @@ TEST(PacedDevice, AnswersWithTheRecordingNoSoonerThanItsModelledTime) {
   EXPECT_THROW(PacedDevice(recording, model, slow), std::invalid_argument);
 }
 
-TEST(PacedDevice, PolledHandOversAgainstItGiveTheRecordedFramesPairs) {
+TEST(PacedBroadPhase, PolledHandOversAgainstThePacedDeviceGiveTheRecordedFramesPairs) {
   for (const auto& [name, boxes] : adversarialScenes(600, 31)) {
     AnswerRecording recording;
-    ModelBackend shape(2, 64, 5);
     RecordingDevice recorder(std::make_unique<ModelBackend>(2, 64, 5), recording);
     BroadPhase sync(recorder, 16, 8, PartitionKind::UniformGrid);
-    PacedDevice* device = nullptr;
-    BroadPhase polled(
-        [&] {
-          auto d = std::make_unique<PacedDevice>(recording, shape, PipelineModel{});
-          device = d.get();
-          return d;
-        },
-        16, 1, 8, PartitionKind::UniformGrid, HandOvers::Polled);
+    sync.setFirstBatchCells(2);
+    PacedBroadPhase polled(recording, recorder, PipelineModel{}, 16, 8, 2, PartitionKind::UniformGrid);
+    EXPECT_EQ(polled.phase().handOvers(), HandOvers::Polled);
     for (int frame = 0; frame < 2; ++frame) {
       recording.clear();
       std::vector<Pair> expected, pairs;
       sync.findPairs(boxes, expected);
-      polled.awakenDevices();
-      device->rewind(PacedDevice::Clock::now());
+      polled.awakenDevice();
       polled.findPairs(boxes, pairs);
       EXPECT_EQ(pairs, expected) << name;
       EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << name;
-      EXPECT_EQ(polled.stats().deviceCycles(), sync.stats().deviceCycles()) << name;
+      EXPECT_EQ(polled.phase().stats().deviceCycles(), sync.stats().deviceCycles()) << name;
+      EXPECT_EQ(polled.device().spans().size(), static_cast<std::size_t>(frame + 1)) << name;  // rewound each frame
     }
   }
 }

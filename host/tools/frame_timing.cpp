@@ -162,9 +162,7 @@ int main(int argc, char** argv) {
     std::vector<std::vector<std::pair<double, double>>> modelledSpans;
     // --paced: the same configuration's asynchronous hand-overs on a paced device, of each kind.
     struct Paced {
-      bpaccel::HandOvers handOvers;
-      std::unique_ptr<bpaccel::BroadPhase> phase;
-      bpaccel::PacedDevice* device = nullptr;  // owned by the phase's device thread
+      std::unique_ptr<bpaccel::PacedBroadPhase> phase;
       std::vector<double> wall, lastReady, waits, decode;
     };
     std::vector<std::unique_ptr<Paced>> paced;
@@ -193,16 +191,9 @@ int main(int argc, char** argv) {
         deviceModel.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(keyWidth));
         for (const auto kind : {bpaccel::HandOvers::Asynchronous, bpaccel::HandOvers::Polled}) {
           auto run = std::make_unique<Timed::Paced>();
-          run->handOvers = kind;
-          // Built on the device's thread while the constructor waits: the pointer is set when it returns.
-          run->phase = std::make_unique<bpaccel::BroadPhase>(
-              [&t, &run, deviceModel] {
-                auto device = std::make_unique<bpaccel::PacedDevice>(*t.recording, *t.backend, deviceModel);
-                run->device = device.get();
-                return device;
-              },
-              cellSize, 1, cellsPerBatch, bpaccel::parsePartitionKind(partition), kind);
-          run->phase->setFirstBatchCells(first);
+          run->phase = std::make_unique<bpaccel::PacedBroadPhase>(*t.recording, *t.backend, deviceModel, cellSize,
+                                                                  cellsPerBatch, first,
+                                                                  bpaccel::parsePartitionKind(partition), kind);
           t.paced.push_back(std::move(run));
         }
       }
@@ -252,16 +243,16 @@ int main(int argc, char** argv) {
         for (std::size_t q = 0; q < t.paced.size(); ++q) {  // the kinds in a rotating order too
           Timed::Paced& run = *t.paced[(q + turn) % t.paced.size()];
           for (std::size_t b = 0; b < flood.size(); b += 64) sink += static_cast<unsigned char>(++flood[b]);
-          run.phase->awakenDevices();  // as the bench does: the emulated device, like a card, needs no waking
+          run.phase->awakenDevice();  // as the bench does: the emulated device, like a card, needs no waking
           const auto p0 = Clock::now();
-          run.device->rewind(p0);
           run.phase->findPairs(recorded[f], pairs);
           run.wall.push_back(std::chrono::duration<double>(Clock::now() - p0).count());
           // When the producer handed its last batch over (waits for room left out).
-          run.lastReady.push_back(run.phase->runs().back().readySeconds);
-          run.waits.push_back(run.phase->times().backendSeconds);
+          const bpaccel::BroadPhase& phase = run.phase->phase();
+          run.lastReady.push_back(phase.runs().back().readySeconds);
+          run.waits.push_back(phase.times().backendSeconds);
           double decoding = 0;
-          for (const auto& r : run.phase->runs()) decoding += r.decodeSeconds;
+          for (const auto& r : phase.runs()) decoding += r.decodeSeconds;
           run.decode.push_back(decoding);
           std::sort(pairs.begin(), pairs.end());
           if (pairs != exact[f]) {
@@ -287,10 +278,10 @@ int main(int argc, char** argv) {
                us(t.pipelined), us(t.pipelinedPolled), clockMHz, pairs.size(), stats.hits, stats.runs, stats.batches,
                stats.deviceCycles(), median(t.allocations));
     for (const auto& run : t.paced) {
-      const bool polled = run->handOvers == bpaccel::HandOvers::Polled;
+      const bool polled = run->phase->phase().handOvers() == bpaccel::HandOvers::Polled;
       const std::string kind = polled ? "paced, polled" : "paced, decoder thread";
       const auto& modelled = polled ? t.pipelinedPolled : t.pipelined;
-      const auto& late = run->device->lateSeconds();
+      const auto& late = run->phase->device().lateSeconds();
       std::vector<double> ratio;
       for (std::size_t i = 0; i < run->wall.size(); ++i) ratio.push_back(run->wall[i] / modelled[i]);
       fmt::print("  {}: asynchronous hand-overs against a device held for its modelled time: frame_us {:.1f} "
@@ -304,9 +295,9 @@ int main(int argc, char** argv) {
       fmt::print("  {}: the producer waited {:.1f} us a frame for room and for the last answers; decoding took "
                  "{:.1f} us a frame ({})\n",
                  kind, us(run->waits), us(run->decode), polled ? "on the producer" : "on the decoder thread");
-      if (!run->device->spans().empty())
+      if (!run->phase->device().spans().empty())
         fmt::print("  {}: the device's hand-overs, median us from the frame's start:{}\n", kind,
-                   medianSpans(run->device->spans()));
+                   medianSpans(run->phase->device().spans()));
     }
     if (!t.modelledSpans.empty() && !t.modelledSpans.front().empty())
       fmt::print("  MODELLED (producer decoding): the device's hand-overs, median us from the frame's start:{}\n",
