@@ -33,10 +33,10 @@
 
 #include <fmt/format.h>
 
-#include "backend.hpp"
-#include "broad_phase.hpp"
+#include "device/backend.hpp"
+#include "broad_phase/broad_phase.hpp"
 #include "fuzz_check.hpp"
-#include "keys.hpp"
+#include "core/keys.hpp"
 #include "scenes.hpp"
 
 using namespace bpaccel;

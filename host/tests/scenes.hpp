@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "types.hpp"
+#include "core/types.hpp"
 
 namespace bpaccel::testing {
 

@@ -10,7 +10,7 @@
 #include <btBulletDynamicsCommon.h>
 
 #include <bpaccel/bpaccel_params.h>
-#include <bpaccel/bullet_drop_in.hpp>
+#include <bpaccel/bullet/bullet_drop_in.hpp>
 
 int main() {
   btDefaultCollisionConfiguration config;

@@ -1,0 +1,131 @@
+#pragma once
+// The project's own broad phase as benchmark methods: the accelerator (device
+// modelled from its cycle counters, host measured) and the cpu backend.
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "device/backend.hpp"
+#include "broad_phase/broad_phase.hpp"
+#include "model/paced_device.hpp"
+#include "timed_method.hpp"
+
+namespace bpaccel {
+
+/// Modelled link between host and accelerator. Boxes stream through the
+/// device's load port, one box a cycle (24 bytes with 32-bit keys), while they arrive: the load
+/// cycles are device time, and the link adds only what it is slower than the
+/// port. Each hand-over (a batch of cells, or a single run) pays a latency
+/// (command and completion); result beats come back over the link.
+///   transfer = hand-overs * latency + max(0, box bytes / bandwidth - load cycles / clock)
+///            + result bytes / bandwidth
+struct LinkModel {
+  double bandwidthBytesPerSecond = 4e9;  // a PCIe Gen3 x4 link's order of magnitude
+  double latencySecondsPerRun = 1e-6;    // one command and one completion per hand-over
+  double bytesPerBox = 24;               // six keys of the device's key width
+  double seconds(const RunStats& s, std::size_t bytesPerBeat, double clockHz) const;
+};
+
+/// A device clock and where it came from, for the table's legend.
+struct DeviceClock {
+  double hz = 100e6;
+  std::string source = "default 100 MHz";
+};
+
+/// The default clock of a device with m lanes of architecture `arch` and
+/// `keyWidth`-bit keys: the Fmax that the FPGA flow's report at `fpgaReport`
+/// measured, if that report is a valid result for the same m, architecture
+/// and key width; otherwise 100 MHz, with the reason in `source`. Reports
+/// without "arch" predate the stream architecture and are the seed's; those
+/// without "key_width" are of 32-bit keys.
+DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std::string& arch, int keyWidth = 32);
+
+/// Where the FPGA flow writes the report of that device (make fpga's FPGA_NAME):
+/// results/fpga/[<arch>-]m<m>[-k<width>].json, no prefix for the seed, no suffix for 32-bit keys.
+std::string fpgaReportPath(int m, const std::string& arch, int keyWidth);
+
+/// The device the accelerator methods model, given at run time by the program
+/// that links a hardware configuration (the benchmark library links none).
+struct DeviceConfig {
+  std::string backend = "model";                      // where device cycles come from: rtl or model
+  std::function<std::unique_ptr<Backend>()> makeBackend;
+  std::size_t beatBytes = 0;                          // bytes of one result beat
+  nlohmann::json hardware;                            // m, capacity, ... as the JSON reports them
+  double clockHz = 100e6;
+  std::string clockSource = "default 100 MHz";
+  LinkModel link;
+  /// Cells per hand-over to the device (the hardware's batch front end);
+  /// 1 hands each cell over on its own, as before batches existed.
+  std::size_t cellsPerBatch = 1;
+  /// Cells of a frame's first hand-over, doubling up to cellsPerBatch
+  /// (BroadPhase::setFirstBatchCells); 0: every hand-over holds cellsPerBatch.
+  std::size_t firstBatchCells = 0;
+  /// Each frame also runs paced (TimedMethod::runPaced): the host's polled
+  /// asynchronous hand-overs (HandOvers::Polled) against a PacedDevice that
+  /// replays the frame's recorded answers in their modelled time. Needs
+  /// cellsPerBatch of at least 2.
+  bool paced = false;
+};
+
+/// BroadPhase on the device: host part measured, device and link modelled.
+/// With DeviceConfig::paced, the device's answers are recorded in update()
+/// (RecordingDevice) and runPaced() runs the frame again on a second broad
+/// phase with polled asynchronous hand-overs, against a PacedDevice.
+class AcceleratorMethod final : public TimedMethod {
+ public:
+  AcceleratorMethod(std::shared_ptr<const DeviceConfig> device, std::optional<std::size_t> cellSize,
+                    PartitionKind partition = PartitionKind::KdTree);
+  void update(std::span<const Aabb> boxes) override;
+  void pairs(std::vector<Pair>& out) override { out = pairs_; }
+  /// Host = measured wall time minus the time spent simulating the device;
+  /// device = every busy cycle (loads included) / clock; transfer = LinkModel.
+  FrameTime frameTime(double measuredSeconds) const override;
+  bool hasPacedRun() const override { return pacedPhase_ != nullptr; }
+  void readyPacedDevice() override {
+    if (pacedPhase_) pacedPhase_->awakenDevice();
+  }
+  void runPaced(std::span<const Aabb> boxes) override;
+
+ private:
+  PipelineModel pipelineModel() const;
+  std::shared_ptr<const DeviceConfig> device_;
+  std::unique_ptr<AnswerRecording> recording_;  // with paced runs: the last update's answers
+  std::unique_ptr<Backend> backend_;
+  BroadPhase phase_;
+  // After the recording and the recorded backend, which its device thread reads: it goes first.
+  std::unique_ptr<PacedBroadPhase> pacedPhase_;
+  std::vector<Pair> pairs_;
+};
+
+/// BroadPhase on the cpu backend: software alone, all measured. With several
+/// threads the tree is built on one and its cells shared out among them.
+class CpuMethod final : public TimedMethod {
+ public:
+  explicit CpuMethod(std::optional<std::size_t> cellSize, std::size_t threads = 1,
+                     PartitionKind partition = PartitionKind::KdTree)
+      : phase_([] { return std::make_unique<CpuBackend>(); }, cellSize, threads, 1, partition) {}
+  void update(std::span<const Aabb> boxes) override { phase_.findPairs(boxes, pairs_); }
+  void pairs(std::vector<Pair>& out) override { out = pairs_; }
+
+ private:
+  BroadPhase phase_;
+  std::vector<Pair> pairs_;
+};
+
+/// "accelerator k-d C" per cell size (none = no tree, all pairs: skipped above `maxAllPairsTests`);
+/// with the grid partition "accelerator grid C" (none = the same all pairs as k-d none: left out).
+std::vector<MethodSpec> acceleratorMethods(std::shared_ptr<const DeviceConfig> device,
+                                           const std::vector<std::optional<std::size_t>>& cellSizes,
+                                           double maxAllPairsTests, PartitionKind partition = PartitionKind::KdTree);
+/// "cpu k-d C" (or "cpu grid C") per cell size, with the same rules.
+std::vector<MethodSpec> cpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, double maxAllPairsTests,
+                                   PartitionKind partition = PartitionKind::KdTree);
+/// "cpu k-d C, T threads" per cell size with a tree.
+std::vector<MethodSpec> threadedCpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, std::size_t threads);
+
+}  // namespace bpaccel

@@ -1,0 +1,80 @@
+#pragma once
+// The Verilated accelerator as a Backend.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+
+#include "../backend.hpp"
+
+class VBroadPhaseAccel;
+class VerilatedContext;
+
+namespace bpaccel {
+
+/// Drives the generated hardware cycle by cycle through its load port, start
+/// command and result port, and reports the hardware's own counters. The
+/// configuration comes from bpaccel_params.h, and the constructor checks it
+/// against the model's info port.
+class RtlBackend final : public Backend {
+ public:
+  /// `consumerReady(cycle)` is the result consumer's ready pattern; by default
+  /// it is always ready, like a host that drains a FIFO at full rate.
+  explicit RtlBackend(std::function<bool(std::uint64_t)> consumerReady = {});
+  ~RtlBackend() override;
+  RtlBackend(const RtlBackend&) = delete;
+  RtlBackend& operator=(const RtlBackend&) = delete;
+
+  std::string name() const override { return "rtl"; }
+  std::size_t capacity() const override;
+  /// On any failure (a hang, a hardware error) the device is reset before the
+  /// exception leaves, so the next run starts from an idle accelerator.
+  void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
+  /// Pushes the cells' counts (and splits) on the batch port and streams
+  /// their boxes, one a cycle, as hardware batches of at most batchCells()
+  /// cells each. On any failure the device is reset and nothing of the call
+  /// is left in `out`, `cellEnds` or `stats`.
+  using Backend::runBatch;
+  void runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
+                std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) override;
+  /// BPACCEL_BIPARTITE_RUNS: the stream architecture's hardware.
+  bool bipartite() const override;
+  unsigned keyWidth() const override;
+  /// One start with the split; the same reset on failure as run().
+  void runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                    RunStats& stats) override;
+
+  static std::size_t lanes();
+  static std::size_t batchCells();
+  /// "seed" or "stream": the architecture this host was built with.
+  static std::string architecture();
+  static std::uint64_t runOverheadCycles();
+
+ private:
+  void settle();  // evaluate combinational outputs for the current inputs
+  void tick();    // one rising clock edge
+  void reset();
+  void runGuarded(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats);
+  void runOnHardware(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats);
+  void batchOnHardware(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
+                       std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats);
+
+  std::unique_ptr<VerilatedContext> context_;
+  std::unique_ptr<VBroadPhaseAccel> top_;
+  std::function<bool(std::uint64_t)> consumerReady_;
+};
+
+/// The C++ model of exactly the hardware this host was built with; with
+/// `keyWidth`, of the same hardware at that key width (what narrower keys
+/// would cost the host, without building it: frame_timing).
+ModelBackend modelOfBuiltHardware(std::optional<unsigned> keyWidth = std::nullopt);
+/// The backend `name` ("rtl", "model" or "cpu") on the hardware this host was
+/// built with; throws std::invalid_argument for another name.
+std::unique_ptr<Backend> makeBuiltBackend(const std::string& name);
+/// Bytes of one result beat of that hardware ({iBase, jBase, mask[m]}), for the link model.
+std::size_t resultBeatBytesOfBuiltHardware();
+/// Bytes of one box on that hardware's load port (six keys of BPACCEL_KEY_WIDTH bits), for the link model.
+std::size_t loadBoxBytesOfBuiltHardware();
+
+}  // namespace bpaccel
