@@ -19,6 +19,7 @@
 #include "bpaccel_params.h"
 #include "broad_phase/broad_phase.hpp"
 #include "core/keys.hpp"
+#include "core/median.hpp"
 #include "device/rtl/rtl_backend.hpp"
 
 namespace {
@@ -30,11 +31,6 @@ std::optional<std::size_t> parseCellSize(const std::string& text) {
   } catch (const std::invalid_argument& e) {
     throw CLI::ValidationError("--cell-size", e.what());
   }
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : (v[(v.size() - 1) / 2] + v[v.size() / 2]) / 2;
 }
 
 int runPairs(const std::string& input, const std::string& backendName, const std::string& cellSizeText,
@@ -81,7 +77,8 @@ int runPairs(const std::string& input, const std::string& backendName, const std
                "host-without-backend {:.6f} (median of {} frames)\n",
                backend->name(), cellSizeText, broadPhase.partition().name(), boxes.size(), pairs.size(), s.runs,
                s.batches, s.cycles, s.issueCycles, s.stallCycles, s.hits, s.boxesSent, s.beatsReceived,
-               median(convert), median(partitionTime), median(cells), median(total), median(host), repeat);
+               bpaccel::median(convert), bpaccel::median(partitionTime), bpaccel::median(cells),
+               bpaccel::median(total), bpaccel::median(host), repeat);
   }
   return 0;
 }

@@ -11,8 +11,10 @@
 
 #include <fmt/format.h>
 
+#include "device/cpu_backend.hpp"
 #include "peers/bullet_broadphases.hpp"
 #include "bullet/bullet_drop_in.hpp"
+#include "core/median.hpp"
 #include "step_timing.hpp"
 
 #include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
@@ -26,13 +28,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const std::size_t h = v.size() / 2;
-  return v.size() % 2 ? v[h] : (v[h - 1] + v[h]) / 2;
-}
 
 nlohmann::json summary(const std::vector<double>& v, double scale) {
   if (v.empty()) return nullptr;

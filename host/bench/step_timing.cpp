@@ -4,14 +4,13 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "core/median.hpp"
+
 namespace bpaccel {
 
 double StepTimes::median() const {
   if (stepSeconds.empty()) throw std::logic_error("StepTimes::median: no frame was timed");
-  std::vector<double> sorted = stepSeconds;
-  const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
-  std::nth_element(sorted.begin(), mid, sorted.end());
-  return *mid;
+  return bpaccel::median(stepSeconds);
 }
 
 StepTimes timeWholeSteps(const SceneConfig& scene, const BroadphaseFactory& makeBroadphase, std::size_t frames,

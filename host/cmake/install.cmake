@@ -3,7 +3,8 @@
 # bpaccel::partition, bpaccel::device, bpaccel::broad_phase, and
 # bpaccel::bpaccel, the Bullet drop-in) and as a pkg-config file. Headers go
 # to include/bpaccel/<folder>/, with the generator's bpaccel_params.h (the
-# configuration the model backend is built for) in include/bpaccel/.
+# configuration the model backend is built for) beside device/built_device.hpp,
+# which reads it.
 include(CMakePackageConfigHelpers)
 set(BPACCEL_VERSION 0.1.0)
 
@@ -11,7 +12,7 @@ install(TARGETS bpaccel_core bpaccel_partition bpaccel_device bpaccel_broad_phas
   EXPORT bpaccelTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   FILE_SET HEADERS DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bpaccel
-  FILE_SET params DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bpaccel)
+  FILE_SET params DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bpaccel/device)
 set(_bpaccel_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/bpaccel)
 install(EXPORT bpaccelTargets NAMESPACE bpaccel:: DESTINATION ${_bpaccel_cmake_dir})
 configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/bpaccelConfig.cmake.in

@@ -33,6 +33,8 @@
 
 #include <fmt/format.h>
 
+#include "device/model_backend.hpp"
+#include "device/cpu_backend.hpp"
 #include "device/backend.hpp"
 #include "broad_phase/broad_phase.hpp"
 #include "fuzz_check.hpp"
@@ -209,8 +211,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::vector<Aabb> boxes = decodeScene(in);
 
   CpuBackend cpu;
-  ModelBackend model(m, capacity, /*runOverheadCycles=*/3, streamReadLatency, batchCells, /*overlapsLoads=*/false,
-                     keyWidth);
+  DeviceParams params = streamReadLatency ? DeviceParams::stream(m, capacity, /*runOverheadCycles=*/3, streamReadLatency)
+                                          : DeviceParams::seed(m, capacity, /*runOverheadCycles=*/3);
+  params.batchCells = batchCells;
+  params.keyWidth = keyWidth;
+  ModelBackend model(params);
   std::vector<Setup> setups;
   std::vector<std::optional<std::size_t>> cells{std::nullopt};
   if (cell) cells.push_back(cell);
@@ -232,9 +237,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                       }});
   }
   if (threads > 1 && cell) {
-    const auto makeModel = [m, capacity, streamReadLatency, batchCells, keyWidth]() -> std::unique_ptr<Backend> {
-      return std::make_unique<ModelBackend>(m, capacity, 3, streamReadLatency, batchCells, false, keyWidth);
-    };
+    const auto makeModel = [params]() -> std::unique_ptr<Backend> { return std::make_unique<ModelBackend>(params); };
     setups.push_back({fmt::format("model {} m {} capacity {} keys {} cell {} threads {} batch {}/{}", arch, m, capacity,
                                   keyWidth, *cell, threads, cellsPerBatch, batchCells),
                       [makeModel, cell, threads, cellsPerBatch] {

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "device/cpu_backend.hpp"
 #include "device/backend.hpp"
 #include "broad_phase/broad_phase.hpp"
 #include "model/paced_device.hpp"

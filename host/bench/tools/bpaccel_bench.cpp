@@ -35,8 +35,9 @@ std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, do
   auto device = std::make_shared<bpaccel::DeviceConfig>();
   device->backend = backend;
   device->makeBackend = [backend] { return bpaccel::makeBuiltBackend(backend); };
-  device->beatBytes = bpaccel::resultBeatBytesOfBuiltHardware();
-  device->link.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytesOfBuiltHardware());
+  const bpaccel::DeviceParams built = bpaccel::builtDeviceParams();
+  device->beatBytes = built.resultBeatBytes();
+  device->link.bytesPerBox = static_cast<double>(built.loadBoxBytes());
   device->hardware = {{"m", BPACCEL_M},
                       {"capacity", BPACCEL_CAPACITY},
                       {"key_width", BPACCEL_KEY_WIDTH},

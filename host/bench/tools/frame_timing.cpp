@@ -42,9 +42,12 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "device/model_backend.hpp"
+#include "device/cpu_backend.hpp"
 #include "device/async_backend.hpp"
 #include "device/backend.hpp"
 #include "broad_phase/broad_phase.hpp"
+#include "core/median.hpp"
 #include "exact_pairs.hpp"
 #include "model/paced_device.hpp"
 #include "device/rtl/rtl_backend.hpp"
@@ -66,12 +69,7 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return (v[(v.size() - 1) / 2] + v[v.size() / 2]) / 2;
-}
+using bpaccel::median;
 
 // Hand-over h's median span over the frames, in us: " from-to" each.
 std::string medianSpans(const std::vector<std::vector<std::pair<double, double>>>& spans) {
@@ -136,7 +134,8 @@ int main(int argc, char** argv) {
   for (std::size_t f = 0; f < frames; ++f) bpaccel::exactPairs(recorded[f], exact[f]);
 
   if (firstBatchCells.empty()) firstBatchCells.push_back(cellsPerBatch);
-  const unsigned builtKeyWidth = bpaccel::modelOfBuiltHardware().keyWidth();
+  const bpaccel::DeviceParams built = bpaccel::builtDeviceParams();
+  const unsigned builtKeyWidth = built.keyWidth;
   if (keyWidths.empty()) keyWidths.push_back(builtKeyWidth);
   if (backendName != "model" && (keyWidths.size() > 1 || keyWidths.front() != builtKeyWidth)) {
     fmt::print(stderr, "frame_timing: --key-width other than the built hardware's ({}) needs --backend model\n",
@@ -147,7 +146,9 @@ int main(int argc, char** argv) {
     if (backendName == "rtl") return std::make_unique<bpaccel::RtlBackend>();
     if (backendName == "cpu")  // software all-pairs: the host's own parts stand out in a profile
       return std::make_unique<bpaccel::CpuBackend>();
-    return std::make_unique<bpaccel::ModelBackend>(bpaccel::modelOfBuiltHardware(keyWidth));
+    bpaccel::DeviceParams params = built;
+    params.keyWidth = keyWidth;  // what narrower keys would cost the host, without building that hardware
+    return std::make_unique<bpaccel::ModelBackend>(params);
   };
   // One configuration: its backend, its broad phase and its figures.
   struct Timed {
@@ -171,7 +172,7 @@ int main(int argc, char** argv) {
   };
   bpaccel::PipelineModel model;  // the benchmark's link model (--link-gbytes-per-s 4, --link-latency-us 1)
   model.clockHz = clockMHz * 1e6;
-  model.bytesPerBeat = static_cast<double>(bpaccel::resultBeatBytesOfBuiltHardware());
+  model.bytesPerBeat = static_cast<double>(built.resultBeatBytes());
   if (paced && (backendName != "model" || cellsPerBatch < 2)) {
     fmt::print(stderr, "frame_timing: --paced needs --backend model and --cells-per-batch of at least 2\n");
     return 2;

@@ -9,7 +9,8 @@
 
 #include <btBulletDynamicsCommon.h>
 
-#include <bpaccel/bpaccel_params.h>
+#include <bpaccel/device/built_device.hpp>
+#include <bpaccel/device/model_backend.hpp>
 #include <bpaccel/bullet/bullet_drop_in.hpp>
 
 int main() {
@@ -17,7 +18,7 @@ int main() {
   btCollisionDispatcher dispatcher(&config);
   // In place of `btDbvtBroadphase broadphase;`:
   bpaccel::Broadphase broadphase(
-      std::make_unique<bpaccel::ModelBackend>(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES));
+      std::make_unique<bpaccel::ModelBackend>(bpaccel::builtDeviceParams()));
   btSequentialImpulseConstraintSolver solver;
   btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
   world.setGravity(btVector3(0, -10, 0));

@@ -7,6 +7,8 @@
 #include <immintrin.h>
 #endif
 
+#include "cpu_features.hpp"
+
 namespace bpaccel {
 namespace {
 
@@ -95,7 +97,7 @@ __attribute__((target("avx2"))) void avx2Pairs(const AllPairsKernel::Scratch& s,
 
 AllPairsKernel::AllPairsKernel() : AllPairsKernel(scalarPairs, "scalar") {
 #if defined(__x86_64__)
-  if (__builtin_cpu_supports("avx2")) {
+  if (cpuHasAvx2()) {
     impl_ = avx2Pairs;
     isa_ = "avx2";
   } else {

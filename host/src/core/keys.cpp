@@ -10,6 +10,8 @@
 
 #include <fmt/format.h>
 
+#include "cpu_features.hpp"
+
 namespace bpaccel {
 
 InputError::InputError(std::size_t object, const std::string& reason)
@@ -239,8 +241,6 @@ __attribute__((target("avx2"))) std::size_t toKeysAvx2(std::span<const Aabb> box
   return i;
 }
 
-// Whether this CPU runs the AVX2 loop.
-bool useAvx2() { return __builtin_cpu_supports("avx2"); }
 #endif
 
 void addBox(const KeyBox& k, KeyBounds& bounds) {
@@ -260,7 +260,7 @@ void convert(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds* b
   bool bad = false;
   std::size_t first = 0;
 #if defined(__x86_64__)
-  if (useAvx2()) first = bounds ? toKeysAvx2<true>(boxes, out, bad, bounds) : toKeysAvx2<false>(boxes, out, bad, nullptr);
+  if (cpuHasAvx2()) first = bounds ? toKeysAvx2<true>(boxes, out, bad, bounds) : toKeysAvx2<false>(boxes, out, bad, nullptr);
   // The boxes the AVX2 loop left (up to three), or all of them without it.
   first = bounds ? toKeysSse2<true>(boxes, out, first, bad, bounds)
                  : toKeysSse2<false>(boxes, out, first, bad, nullptr);
@@ -398,7 +398,7 @@ void narrowKeys(std::span<const KeyBox> cell, unsigned width, std::span<KeyBox> 
   // it keeps the map monotone and in range all the same.
 #if defined(__x86_64__)
   static_assert(sizeof(KeyBox) == 24, "four boxes are three 32-byte vectors");
-  if (useAvx2()) return narrowAvx2(cell, width, out);
+  if (cpuHasAvx2()) return narrowAvx2(cell, width, out);
 #endif
   detail::narrowKeysScalar(cell, width, out);
 }

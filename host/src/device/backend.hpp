@@ -1,14 +1,13 @@
 #pragma once
-// The broad-phase backend interface: all-pairs over one batch of boxes.
+// The device interface: all pairs over one run, or over a batch of cells,
+// of at most capacity() boxes each.
 
 #include <cstddef>
-#include <limits>
 #include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
-#include "../core/all_pairs_kernel.hpp"
 #include "../core/types.hpp"
 
 namespace bpaccel {
@@ -72,9 +71,6 @@ class Backend {
   }
 };
 
-/// Bytes of one box on a device's load port: six keys of `keyWidth` bits (the link model's box).
-constexpr std::size_t loadBoxBytes(unsigned keyWidth) { return (6 * std::size_t{keyWidth} + 7) / 8; }
-
 /// The accelerator's schedule in closed form: issue cycles of one run of n
 /// objects with m lanes, sum over blocks b of (n - 1 - b*m); 0 for n < 2.
 /// A bipartite run (split = na > 0) runs the blocks b*m <= na-1 only, in
@@ -82,70 +78,5 @@ constexpr std::size_t loadBoxBytes(unsigned keyWidth) { return (6 * std::size_t{
 /// bpaccel.Schedule.issueCycles in the generator (tests compare it with the
 /// Verilated hardware's own counter).
 std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m, std::uint64_t split = 0);
-
-/// Fast C++ model of the accelerator: the same schedule, pairs and cycle
-/// counts (loads included) as the RTL driven by a host that loads one box a
-/// cycle and a consumer that never stalls, for any n up to its capacity and
-/// at software speed. Both architectures share the schedule and differ only
-/// in the cycles before the first issue: none for the seed's; for the
-/// stream's, streamReadLatency (BPACCEL_READ_LATENCY, 0 for
-/// the seed's, so passing the header's values always models the hardware built).
-/// Batches of up to `batchCells` cells (BPACCEL_BATCH_CELLS) cost what the
-/// hardware's front end adds: one cycle per batch and one per cell; with
-/// `overlapsLoads` (BPACCEL_BATCH_OVERLAPS_LOADS) each cell loads while the
-/// one before runs, so its load cycles are only those no run hides.
-class ModelBackend final : public Backend {
- public:
-  ModelBackend(std::size_t m, std::size_t capacity, std::uint64_t runOverheadCycles,
-               std::uint64_t streamReadLatency = 0, std::size_t batchCells = 64, bool overlapsLoads = false,
-               unsigned keyWidth = 32);
-  std::string name() const override { return "model"; }
-  std::size_t capacity() const override { return capacity_; }
-  unsigned keyWidth() const override { return keyWidth_; }
-  void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
-  using Backend::runBatch;
-  void runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
-                std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) override;
-  /// The stream architecture's (streamReadLatency > 0); the seed's hardware refuses a split.
-  bool bipartite() const override { return streamReadLatency_ != 0; }
-  void runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
-                    RunStats& stats) override;
-
- private:
-  /// One cell's pairs and counters (split 0: all pairs), without counting it
-  /// as a run; its load cycles and cycles depend on the hand-over (run, or batchCycles).
-  void runCell(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats) const;
-  /// One cell as its own run and hand-over: runCell plus its loads and busy cycles.
-  void runAlone(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats) const;
-  /// Cycles before a run of n objects issues (0 for the seed), and all its busy cycles.
-  std::uint64_t startupCycles(std::uint64_t n) const;
-  std::uint64_t busyCycles(std::uint64_t n, std::uint64_t split = 0) const;
-  /// One hardware batch's load and run cycles, cell by cell on the device's
-  /// timeline (`splits`: one per cell, or empty).
-  void batchCycles(std::span<const std::span<const KeyBox>> batch, std::span<const std::size_t> splits,
-                   RunStats& stats) const;
-
-  std::size_t m_;
-  std::size_t capacity_;
-  std::uint64_t overhead_;
-  std::uint64_t streamReadLatency_;  // 0: the seed architecture
-  std::size_t batchCells_;
-  bool overlapsLoads_;
-  unsigned keyWidth_;
-};
-
-/// Software alone: all pairs of the batch with SIMD compares (AllPairsKernel),
-/// no capacity limit. One instance per thread: it keeps scratch space.
-class CpuBackend final : public Backend {
- public:
-  std::string name() const override { return "cpu"; }
-  std::size_t capacity() const override { return std::numeric_limits<std::size_t>::max(); }
-  void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
-  std::string_view isa() const { return kernel_.isa(); }
-
- private:
-  AllPairsKernel kernel_;
-  AllPairsKernel::Scratch scratch_;
-};
 
 }  // namespace bpaccel

@@ -11,6 +11,7 @@
 #include <immintrin.h>
 #endif
 
+#include "../core/cpu_features.hpp"
 #include "../core/keys.hpp"
 
 namespace bpaccel {
@@ -140,7 +141,6 @@ __attribute__((target("avx2"))) std::size_t firstCellsAvx2(const KeyBox* boxes, 
   return i;
 }
 
-bool useAvx2() { return __builtin_cpu_supports("avx2"); }
 #endif
 
 }  // namespace
@@ -315,7 +315,7 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
   // The bench's scenes and any from float boxes without infinities have finite bounds.
   bool finite = true;
   for (const Axis& axis : axes_) finite = finite && axis.keyLo >= kLowestFinite && axis.keyHi <= kHighestFinite;
-  if (useAvx2()) {
+  if (cpuHasAvx2()) {
     LaneConstants lc;
     const std::uint32_t weights[3] = {1, static_cast<std::uint32_t>(nx), static_cast<std::uint32_t>(nx * ny)};
     for (int l = 0; l < 24; ++l) {

@@ -10,6 +10,8 @@
 #include <set>
 #include <sys/wait.h>
 
+#include "device/model_backend.hpp"
+#include "device/built_device.hpp"
 #include "device/backend.hpp"
 #include "benchmark.hpp"
 #include "bpaccel_params.h"
@@ -340,7 +342,7 @@ TEST(Benchmark, APacedRunThatMissesAPairFailsTheRunNamingThePacedRun) {
 TEST(AcceleratorMethod, APacedRunFindsTheUpdatesPairsAndNeedsBatches) {
   const auto boxes = bpaccel::testing::adversarialScenes(1500, 5)[0].second;
   auto d = std::make_shared<DeviceConfig>();
-  d->makeBackend = [] { return std::make_unique<ModelBackend>(modelOfBuiltHardware()); };
+  d->makeBackend = [] { return std::make_unique<ModelBackend>(builtDeviceParams()); };
   d->cellsPerBatch = 8;
   d->paced = true;
   AcceleratorMethod method(d, 16, PartitionKind::UniformGrid);
@@ -521,7 +523,7 @@ TEST(LinkModel, ALinkFasterThanTheLoadPortAddsNothingForBoxes) {
 
 TEST(AcceleratorMethod, DeviceTimeCountsLoadCycles) {
   auto d = std::make_shared<DeviceConfig>();
-  d->makeBackend = [] { return std::make_unique<ModelBackend>(modelOfBuiltHardware()); };
+  d->makeBackend = [] { return std::make_unique<ModelBackend>(builtDeviceParams()); };
   d->clockHz = 100e6;
   AcceleratorMethod method(d, 16);
   const auto boxes = bpaccel::testing::adversarialScenes(200, 1)[0].second;
@@ -538,7 +540,7 @@ TEST(AcceleratorMethod, BatchesPayTheLinkLatencyOncePerHandOverAndFindTheSamePai
   const auto frame = [&](std::size_t cellsPerBatch, std::vector<Pair>& pairs, std::size_t firstBatchCells = 0) {
     auto d = std::make_shared<DeviceConfig>();
     d->firstBatchCells = firstBatchCells;
-    d->makeBackend = [] { return std::make_unique<ModelBackend>(modelOfBuiltHardware()); };
+    d->makeBackend = [] { return std::make_unique<ModelBackend>(builtDeviceParams()); };
     d->clockHz = 100e6;
     d->link.bandwidthBytesPerSecond = 1e12;  // the load port is slower: boxes add no link time
     d->link.latencySecondsPerRun = 1e-6;

@@ -10,6 +10,9 @@
 #include <set>
 #include <stdexcept>
 
+#include "device/model_backend.hpp"
+#include "device/cpu_backend.hpp"
+#include "device/built_device.hpp"
 #include "core/all_pairs_kernel.hpp"
 #include "device/async_backend.hpp"
 #include "model/timeline.hpp"
@@ -41,7 +44,7 @@ void expectExact(Backend& backend, const std::vector<Aabb>& boxes, std::optional
 }  // namespace
 
 TEST(BroadPhase, ModelAndCpuAreExactOnAdversarialScenesForEveryCellSize) {
-  ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+  ModelBackend model(builtDeviceParams());
   CpuBackend cpu;
   for (std::size_t n : {0u, 1u, 2u, 7u, 150u, 600u})
     for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 11))
@@ -56,7 +59,8 @@ TEST(BroadPhase, CoversCellsAboveTheCapacityInChunksExactly) {
   // The seed's model chunks into triangular chunk-pair runs, the stream's into bipartite ones.
   for (std::size_t capacity : {2u, 4u, 6u, 16u})
     for (std::uint64_t streamReadLatency : {0u, 4u}) {
-      ModelBackend small(2, capacity, 5, streamReadLatency);
+      ModelBackend small(streamReadLatency ? DeviceParams::stream(2, capacity, 5, streamReadLatency)
+                                         : DeviceParams::seed(2, capacity, 5));
       for (const auto& [name, boxes] : adversarialScenes(70, 5))
         for (const auto& cell : {std::optional<std::size_t>{}, std::optional<std::size_t>{4},
                                  std::optional<std::size_t>{40}})
@@ -80,7 +84,7 @@ TEST(BroadPhase, CellsAboveTheCapacityRunAsBipartiteChunkPairsTestingEachPairOnc
       triangularIssue += scheduleIssueCycles(sizes[p] + sizes[q], m);
     }
   }
-  ModelBackend stream(m, capacity, 3, 4, 64, true), seed(m, capacity, 3);  // the stream overlaps loads
+  ModelBackend stream(DeviceParams::stream(m, capacity, 3, 4, true)), seed(DeviceParams::seed(m, capacity, 3));
   for (Backend* backend : {static_cast<Backend*>(&stream), static_cast<Backend*>(&seed)}) {
     BroadPhase bp(*backend, 16);
     std::vector<Pair> pairs;
@@ -98,7 +102,7 @@ TEST(BroadPhase, CellsAboveTheCapacityRunAsBipartiteChunkPairsTestingEachPairOnc
   EXPECT_LT(bipartiteIssue, triangularIssue * 7 / 10);  // small chunks: the 2m - 1 prefix per block weighs more
   // Asynchronous hand-overs run the bipartite runs in the same order with the same cycles.
   BroadPhase sync(stream, 16, 5);
-  BroadPhase async([&] { return std::make_unique<ModelBackend>(m, capacity, 3, 4, 64, true); }, 16, 1, 5,
+  BroadPhase async([&] { return std::make_unique<ModelBackend>(DeviceParams::stream(m, capacity, 3, 4, true)); }, 16, 1, 5,
                    PartitionKind::KdTree, HandOvers::Asynchronous);
   std::vector<Pair> expected, pairs;
   sync.findPairs(same, expected);
@@ -117,7 +121,9 @@ TEST(BroadPhase, CellsAboveTheCapacityRunAsBipartiteChunkPairsTestingEachPairOnc
 }
 
 TEST(ModelBackend, BipartiteRunsTestOnlyAcrossTheSplitAndRefuseABadSplit) {
-  ModelBackend stream(3, 64, 3, 4), seed(3, 63, 3);
+  ModelBackend stream(DeviceParams::stream(3, 64, 3, 4));
+  DeviceParams seedParams = DeviceParams::seed(3, 63, 3);
+  ModelBackend seed(seedParams);
   const auto boxes = adversarialScenes(40, 4).at(1).second;  // clusters: many hits
   std::vector<KeyBox> keys;
   toKeys(boxes, keys);
@@ -143,7 +149,7 @@ TEST(ModelBackend, BipartiteRunsTestOnlyAcrossTheSplitAndRefuseABadSplit) {
 TEST(BroadPhase, DegenerateScenesFallBackToChunkedLeaves) {
   // All boxes identical: no plane splits them, so one leaf holds all 300.
   std::vector<Aabb> same(300, box(1, 1, 1, 2, 2, 2));
-  ModelBackend small(4, 64, 5);
+  ModelBackend small(DeviceParams::seed(4, 64, 5));
   BroadPhase bp(small, 16);
   std::vector<Pair> pairs;
   bp.findPairs(same, pairs);
@@ -298,7 +304,7 @@ TEST(BroadPhase, SeveralThreadsGiveExactlyTheSinglePairs) {
   for (std::size_t threads : {2u, 3u}) {
     BroadPhase cpu([] { return std::make_unique<CpuBackend>(); }, 8, threads);
     // A small capacity: cells above it are chunked inside the workers.
-    BroadPhase model([] { return std::make_unique<ModelBackend>(2, 6, 5); }, 16, threads);
+    BroadPhase model([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, 16, threads);
     EXPECT_EQ(cpu.threads(), threads);
     for (std::size_t n : {0u, 2u, 300u, 1000u})
       for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 7)) {
@@ -453,7 +459,7 @@ TEST(ModelPipeline, NeverBeatsTheBusiestLaneNorLosesToTheSerialSum) {
 }
 
 TEST(BroadPhase, RecordsEveryRunInOrderWithItsOwnCounters) {
-  ModelBackend small(4, 64, 5);
+  ModelBackend small(DeviceParams::seed(4, 64, 5));
   BroadPhase bp(small, 16);
   std::vector<Pair> pairs;
   const auto boxes = adversarialScenes(500, 21).front().second;
@@ -495,7 +501,7 @@ class LeafCountingBackend final : public Backend {
 }  // namespace
 
 TEST(BroadPhase, CellsReachTheBackendWhileTheTreeIsStillBeingBuilt) {
-  ModelBackend model(4, 64, 5);
+  ModelBackend model(DeviceParams::seed(4, 64, 5));
   const BroadPhase* phase = nullptr;
   LeafCountingBackend counting(model, phase);
   BroadPhase bp(counting, 16);
@@ -512,7 +518,7 @@ TEST(BroadPhase, CellsReachTheBackendWhileTheTreeIsStillBeingBuilt) {
   EXPECT_TRUE(std::is_sorted(counting.leavesAtRun.begin(), counting.leavesAtRun.end()));
   EXPECT_EQ(sorted(pairs), bruteForce(boxes));
   // The streamed frame is the same as processing the finished tree's leaves in order.
-  ModelBackend again(4, 64, 5);
+  ModelBackend again(DeviceParams::seed(4, 64, 5));
   RunStats sum;
   std::vector<Pair> scratch;
   std::vector<KeyBox> keys;
@@ -581,7 +587,7 @@ TEST(BroadPhase, ScenesLargerThanTheCarryThresholdAreExactOnOneAndTwoThreads) {
 TEST(BroadPhase, BatchesOfCellsGiveExactlyThePairsOfSingleRunsWithTheSameCycles) {
   // A small capacity, so that chunk pairs of oversized cells travel in batches too.
   for (std::size_t capacity : {6u, 64u}) {
-    ModelBackend model(2, capacity, 5);
+    ModelBackend model(DeviceParams::seed(2, capacity, 5));
     for (std::size_t n : {0u, 2u, 300u, 1000u})
       for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 3))
         for (const auto& cell : {std::optional<std::size_t>{}, std::optional<std::size_t>{4},
@@ -646,7 +652,7 @@ class BatchRecordingBackend final : public Backend {
 
 TEST(BroadPhase, BatchesReachTheDeviceInAscendingCellSizeSoThatTheirLoadsHide) {
   // The stream's model: each cell loads while the one before runs.
-  ModelBackend stream(8, 256, 3, 4, 64, true);
+  ModelBackend stream(DeviceParams::stream(8, 256, 3, 4, true));
   const std::vector<Aabb> boxes = scatteredBoxes(3000, 21, -40, 40, 0, 3);
   for (const PartitionKind partition : {PartitionKind::UniformGrid, PartitionKind::KdTree})
     for (const std::size_t perBatch : {7u, 64u}) {
@@ -681,7 +687,7 @@ TEST(BroadPhase, BatchesReachTheDeviceInAscendingCellSizeSoThatTheirLoadsHide) {
 }
 
 TEST(BroadPhase, SlowStartHandsOverFewCellsFirstThenTwiceAsManyEachTimeUpToTheBatch) {
-  ModelBackend stream(8, 256, 3, 4, 64, true);
+  ModelBackend stream(DeviceParams::stream(8, 256, 3, 4, true));
   const std::vector<Aabb> boxes = scatteredBoxes(3000, 21, -40, 40, 0, 3);
   const std::vector<Pair> exact = bruteForce(boxes);
   for (const PartitionKind partition : {PartitionKind::UniformGrid, PartitionKind::KdTree})
@@ -692,7 +698,7 @@ TEST(BroadPhase, SlowStartHandsOverFewCellsFirstThenTwiceAsManyEachTimeUpToTheBa
       BroadPhase bp(recording, 32, perBatch, partition);
       bp.setFirstBatchCells(first);
       EXPECT_EQ(bp.firstBatchCells(), std::min(first, perBatch)) << label;
-      ModelBackend plainModel(8, 256, 3, 4, 64, true);
+      ModelBackend plainModel(DeviceParams::stream(8, 256, 3, 4, true));
       BroadPhase plain(plainModel, 32, perBatch, partition);
       for (int frame = 0; frame < 2; ++frame) {  // each frame starts small again
         recording.batches.clear();
@@ -719,7 +725,7 @@ TEST(BroadPhase, SlowStartHandsOverFewCellsFirstThenTwiceAsManyEachTimeUpToTheBa
 }
 
 TEST(BroadPhase, BatchesWorkOnSeveralThreadsAndRejectZeroCellsPerBatch) {
-  BroadPhase model([] { return std::make_unique<ModelBackend>(2, 6, 5); }, 16, 2, 5);
+  BroadPhase model([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, 16, 2, 5);
   for (std::size_t n : {0u, 2u, 300u, 1000u})
     for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 9)) {
       std::vector<Pair> pairs;
@@ -727,7 +733,7 @@ TEST(BroadPhase, BatchesWorkOnSeveralThreadsAndRejectZeroCellsPerBatch) {
       EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << name;
       EXPECT_LE(model.stats().batches, model.stats().runs) << name;
     }
-  ModelBackend m(2, 6, 5);
+  ModelBackend m(DeviceParams::seed(2, 6, 5));
   EXPECT_THROW(BroadPhase(m, 16, 0), std::invalid_argument);
 }
 
@@ -750,7 +756,7 @@ class FailingModel final : public Backend {
   }
 
  private:
-  ModelBackend model_{2, 16, 5};
+  ModelBackend model_{DeviceParams::seed(2, 16, 5)};
   std::size_t failAt_;
   std::size_t batches_ = 0;
 };
@@ -764,8 +770,8 @@ std::vector<KeyBox> keysOf(const std::vector<Aabb>& boxes) {
 }  // namespace
 
 TEST(AsyncBackend, GivesEachHandOverWhatTheBackendGivesInSubmissionOrder) {
-  ModelBackend direct(2, 16, 5);
-  AsyncBackend async([] { return std::make_unique<ModelBackend>(2, 16, 5); });
+  ModelBackend direct(DeviceParams::seed(2, 16, 5));
+  AsyncBackend async([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 16, 5)); });
   EXPECT_EQ(async.name(), "model");
   EXPECT_EQ(async.capacity(), 16u);
   std::vector<std::vector<KeyBox>> scenes;
@@ -794,7 +800,7 @@ TEST(AsyncBackend, GivesEachHandOverWhatTheBackendGivesInSubmissionOrder) {
 }
 
 TEST(AsyncBackend, PassesTheDevicesFailureToItsHandOverOnlyAndGoesOn) {
-  AsyncBackend async([] { return std::make_unique<ModelBackend>(2, 16, 5); });
+  AsyncBackend async([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 16, 5)); });
   const auto keys = keysOf(scatteredBoxes(20, 3, 0.0f, 10.0f, 1.0f, 4.0f));
   const std::vector<std::span<const KeyBox>> tooLarge = {std::span<const KeyBox>(keys)};  // 20 > capacity 16
   const std::vector<std::span<const KeyBox>> fits = {std::span<const KeyBox>(keys).first(16)};
@@ -821,9 +827,9 @@ TEST(BroadPhase, AsynchronousAndPolledHandOversGiveTheSynchronousPairsCountersAn
         for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 21)) {
           const std::string label = name + " n " + std::to_string(n) + " per batch " + std::to_string(perBatch) +
                                     (handOvers == HandOvers::Polled ? " polled" : " decoder thread");
-          ModelBackend syncModel(2, 64, 5);
+          ModelBackend syncModel(DeviceParams::seed(2, 64, 5));
           BroadPhase sync(syncModel, 16, perBatch, partition);
-          BroadPhase async([] { return std::make_unique<ModelBackend>(2, 64, 5); }, 16, 1, perBatch, partition,
+          BroadPhase async([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)); }, 16, 1, perBatch, partition,
                            handOvers);
           EXPECT_EQ(async.handOvers(), handOvers);
           if (perBatch == 64) {  // with a slow start (hand-overs of 3, 6, 12, ...) on both
@@ -847,7 +853,7 @@ TEST(BroadPhase, AsynchronousAndPolledHandOversGiveTheSynchronousPairsCountersAn
 
 TEST(BroadPhase, AsynchronousAndPolledHandOversWorkOnSeveralThreads) {
   for (const HandOvers handOvers : {HandOvers::Asynchronous, HandOvers::Polled}) {
-    BroadPhase bp([] { return std::make_unique<ModelBackend>(2, 6, 5); }, 16, 2, 5, PartitionKind::KdTree,
+    BroadPhase bp([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, 16, 2, 5, PartitionKind::KdTree,
                   handOvers);
     for (std::size_t n : {2u, 300u, 1000u})
       for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 23)) {
@@ -883,7 +889,10 @@ TEST(BroadPhase, NarrowKeyDevicesGiveExactlyTheFullKeyPairs) {
   for (const unsigned width : {1u, 4u, 16u, 32u}) {
     for (const bool stream : {true, false}) {  // the stream's model (bipartite chunk pairs) and the seed's
       const auto make = [&] {
-        return std::make_unique<ModelBackend>(m, capacity, 3, stream ? 4 : 0, 8, stream, width);
+        DeviceParams p = stream ? DeviceParams::stream(m, capacity, 3, 4, true) : DeviceParams::seed(m, capacity, 3);
+        p.batchCells = 8;
+        p.keyWidth = width;
+        return std::make_unique<ModelBackend>(p);
       };
       for (std::size_t n : {2u, 150u, 400u})
         for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n)))
@@ -910,7 +919,10 @@ TEST(BroadPhase, NarrowKeyDevicesGiveExactlyTheFullKeyPairs) {
 }
 
 TEST(ModelBackend, RefusesKeysWiderThanItsDeviceNamingTheBox) {
-  ModelBackend narrow(2, 8, 3, 4, 8, true, 16);
+  DeviceParams narrowParams = DeviceParams::stream(2, 8, 3, 4, true);
+  narrowParams.batchCells = 8;
+  narrowParams.keyWidth = 16;
+  ModelBackend narrow(narrowParams);
   std::vector<KeyBox> boxes(3, KeyBox{{1, 2, 3}, {4, 5, 6}});
   boxes[2].max[1] = 0x10000;
   std::vector<Pair> out;
@@ -922,6 +934,8 @@ TEST(ModelBackend, RefusesKeysWiderThanItsDeviceNamingTheBox) {
     EXPECT_NE(std::string(e.what()).find("box 2"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("axis 1"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(ModelBackend(2, 8, 3, 4, 8, true, 0), std::invalid_argument);
-  EXPECT_THROW(ModelBackend(2, 8, 3, 4, 8, true, 33), std::invalid_argument);
+  for (const unsigned bad : {0u, 33u}) {
+    narrowParams.keyWidth = bad;
+    EXPECT_THROW(ModelBackend{narrowParams}, std::invalid_argument);
+  }
 }

@@ -17,6 +17,9 @@
 #include <btBulletDynamicsCommon.h>
 #include <gtest/gtest.h>
 
+#include "device/model_backend.hpp"
+#include "device/cpu_backend.hpp"
+#include "device/built_device.hpp"
 #include "bpaccel_params.h"
 #include "bullet/bullet_drop_in.hpp"
 #include "device/rtl/rtl_backend.hpp"
@@ -32,7 +35,7 @@ using bpaccel::Pair;
 std::unique_ptr<bpaccel::Backend> makeBackend(const std::string& name) {
   if (name == "rtl") return std::make_unique<bpaccel::RtlBackend>();
   if (name == "model")
-    return std::make_unique<bpaccel::ModelBackend>(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+    return std::make_unique<bpaccel::ModelBackend>(bpaccel::builtDeviceParams());
   return std::make_unique<bpaccel::CpuBackend>();
 }
 

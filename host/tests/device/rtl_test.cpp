@@ -8,6 +8,9 @@
 
 #include <fmt/format.h>
 
+#include "device/model_backend.hpp"
+#include "device/cpu_backend.hpp"
+#include "device/built_device.hpp"
 #include "device/backend.hpp"
 #include "bpaccel_params.h"
 #include "broad_phase/broad_phase.hpp"
@@ -93,7 +96,7 @@ TEST(RtlBackend, ReportsTheArchitectureItWasBuiltWith) {
 
 TEST(RtlBackend, AgreesWithTheModelOnPairsCyclesAndBeats) {
   RtlBackend rtl;
-  ModelBackend model = modelOfBuiltHardware();
+  ModelBackend model(builtDeviceParams());
   std::mt19937 rng(42);
   std::vector<std::size_t> sizes = {0, 1, 2, 3, BPACCEL_M - 1, BPACCEL_M, BPACCEL_M + 1, 2 * BPACCEL_M + 1,
                                     BPACCEL_CAPACITY};
@@ -108,7 +111,7 @@ TEST(RtlBackend, AgreesWithTheModelOnPairsCyclesAndBeats) {
 TEST(RtlBackend, TheComparisonCatchesAWrongPairAndAWrongCount) {
   // The same comparison as above must fail when one pair or one count is off.
   RtlBackend rtl;
-  ModelBackend model = modelOfBuiltHardware();
+  ModelBackend model(builtDeviceParams());
   const auto boxes = adversarialScenes(40, 3).at(1).second;  // clusters: many hits
   const BothRuns runs = runBoth(rtl, model, boxes);
   ASSERT_FALSE(runs.fromRtl.empty());
@@ -134,7 +137,7 @@ TEST(RtlBackend, TheComparisonCatchesAWrongPairAndAWrongCount) {
 TEST(RtlBackend, StallingConsumerLosesNoPairAndCountsTheStalls) {
   std::mt19937 pattern(5);
   RtlBackend rtl([&](std::uint64_t) { return pattern() % 4 == 0; });
-  ModelBackend model = modelOfBuiltHardware();
+  ModelBackend model(builtDeviceParams());
   std::uint64_t stalls = 0;
   for (const auto& [name, boxes] : adversarialScenes(300, 77)) {
     const auto [fromRtl, fromModel, rtlStats, modelStats] = runBoth(rtl, model, boxes);
@@ -150,7 +153,7 @@ TEST(RtlBackend, StallingConsumerLosesNoPairAndCountsTheStalls) {
 TEST(RtlBackend, RecoversAfterAHungRunAndRunsTheNextBatchExactly) {
   bool consumerStuck = true;  // a consumer that never takes a beat hangs the run
   RtlBackend rtl([&](std::uint64_t) { return !consumerStuck; });
-  ModelBackend model = modelOfBuiltHardware();
+  ModelBackend model(builtDeviceParams());
   const auto dense = adversarialScenes(60, 9).at(1).second;  // clusters: a hit the consumer never takes
   std::vector<Pair> pairs;
   RunStats stats;
@@ -187,7 +190,7 @@ TEST(RtlBackend, IsExactThroughTheKdTreeAndAcrossChunks) {
 
 TEST(RtlBackend, BipartiteRunsAgreeWithTheModelAndTestOnlyAcrossTheSplit) {
   RtlBackend rtl;
-  ModelBackend model = modelOfBuiltHardware();
+  ModelBackend model(builtDeviceParams());
   ASSERT_EQ(rtl.bipartite(), BPACCEL_BIPARTITE_RUNS != 0);
   ASSERT_EQ(model.bipartite(), rtl.bipartite());
   const auto keys = keysOf(adversarialScenes(3 * BPACCEL_M + 5, 21).at(1).second);  // clusters: many hits
@@ -307,7 +310,7 @@ std::uint64_t hardwareBatches(std::size_t cells) { return (cells + BPACCEL_BATCH
 
 TEST(RtlBatch, AgreesWithTheModelAndWithTheCellsRunOneByOne) {
   RtlBackend rtl;
-  ModelBackend model = modelOfBuiltHardware();
+  ModelBackend model(builtDeviceParams());
   // Few cells, one at the capacity, and more cells than one hardware batch holds.
   for (const auto& [cells, seed, full] : {std::tuple{5u, 1u, false}, std::tuple{9u, 2u, true},
                                           std::tuple{BPACCEL_BATCH_CELLS + 7u, 3u, false}}) {
@@ -348,20 +351,22 @@ TEST(RtlBatch, AgreesWithTheModelAndWithTheCellsRunOneByOne) {
     EXPECT_EQ(singles.batches, cells) << label;
     if (cells > BPACCEL_BATCH_CELLS) {
       // The counter comparison can fail: a model that splits into other hardware batches disagrees.
-      ModelBackend wrongSplit(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES, BPACCEL_READ_LATENCY,
-                              BPACCEL_BATCH_CELLS > 1 ? 1 : 2, BPACCEL_BATCH_OVERLAPS_LOADS != 0);
+      DeviceParams wrong = builtDeviceParams();
+      wrong.batchCells = BPACCEL_BATCH_CELLS > 1 ? 1 : 2;
+      ModelBackend wrongSplit(wrong);
       EXPECT_NE(runBatchOn(wrongSplit, b).stats.loadCycles, r.loadCycles) << label;
     }
     // And a model that gets the overlap wrong disagrees too.
-    ModelBackend wrongOverlap(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES, BPACCEL_READ_LATENCY,
-                              BPACCEL_BATCH_CELLS, BPACCEL_BATCH_OVERLAPS_LOADS == 0);
+    DeviceParams wrong = builtDeviceParams();
+    wrong.batchOverlapsLoads = !wrong.batchOverlapsLoads;
+    ModelBackend wrongOverlap(wrong);
     EXPECT_NE(runBatchOn(wrongOverlap, b).stats.loadCycles, r.loadCycles) << label;
   }
 }
 
 TEST(RtlBatch, BipartiteCellsInABatchAgreeWithTheModelAndWithTheirSingleRuns) {
   RtlBackend rtl;
-  ModelBackend model = modelOfBuiltHardware();
+  ModelBackend model(builtDeviceParams());
   const Batch b = randomBatch(BPACCEL_BATCH_CELLS + 5, 9, true);
   // About half the cells of two or more objects bipartite, at a random split.
   std::mt19937 rng(10);
@@ -412,7 +417,7 @@ TEST(RtlBatch, BipartiteCellsInABatchAgreeWithTheModelAndWithTheirSingleRuns) {
 
 TEST(RtlBatch, RefusesBadSplitsNamingTheCellBeforeTouchingTheDevice) {
   RtlBackend rtl;
-  ModelBackend model = modelOfBuiltHardware();
+  ModelBackend model(builtDeviceParams());
   const Batch b = randomBatch(4, 11, false);
   const std::vector<std::size_t> tooFew = {0, 0};
   std::vector<std::size_t> atN(b.spans.size(), 0);
@@ -439,7 +444,7 @@ TEST(RtlBatch, RefusesBadSplitsNamingTheCellBeforeTouchingTheDevice) {
 TEST(RtlBatch, StallingConsumerLosesNoPairAndCountsTheStalls) {
   std::mt19937 pattern(6);
   RtlBackend rtl([&](std::uint64_t) { return pattern() % 3 == 0; });
-  ModelBackend model = modelOfBuiltHardware();
+  ModelBackend model(builtDeviceParams());
   const Batch b = randomBatch(BPACCEL_BATCH_CELLS + 2, 4, false);
   const BatchResult fromRtl = runBatchOn(rtl, b);
   const BatchResult fromModel = runBatchOn(model, b);
@@ -456,7 +461,7 @@ TEST(RtlBatch, StallingConsumerLosesNoPairAndCountsTheStalls) {
 
 TEST(RtlBatch, TheDefaultRunsEachCellAsItsOwnBatch) {
   CpuBackend cpu;
-  ModelBackend model = modelOfBuiltHardware();
+  ModelBackend model(builtDeviceParams());
   const Batch b = randomBatch(12, 5, false);
   const BatchResult fromCpu = runBatchOn(cpu, b);
   const BatchResult fromModel = runBatchOn(model, b);
@@ -484,7 +489,7 @@ TEST(RtlBatch, RejectsACellAboveTheCapacityBeforeTouchingTheDevice) {
 TEST(RtlBatch, RecoversAfterAHungBatchAndRunsTheNextExactly) {
   bool consumerStuck = true;  // a consumer that never takes a beat hangs the batch
   RtlBackend rtl([&](std::uint64_t) { return !consumerStuck; });
-  ModelBackend model = modelOfBuiltHardware();
+  ModelBackend model(builtDeviceParams());
   const Batch b = randomBatch(4, 7, false);
   ASSERT_FALSE(runBatchOn(model, b).pairs.empty());  // a beat the consumer never takes
   std::vector<Pair> pairs = {{0, 1}};  // what the caller had before stays

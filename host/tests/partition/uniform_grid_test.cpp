@@ -5,6 +5,9 @@
 #include <optional>
 #include <random>
 
+#include "device/model_backend.hpp"
+#include "device/cpu_backend.hpp"
+#include "device/built_device.hpp"
 #include "device/backend.hpp"
 #include "bpaccel_params.h"
 #include "broad_phase/broad_phase.hpp"
@@ -80,7 +83,7 @@ void expectCellsPartitionSpaceAndHoldExactlyTheirBoxes(const Partition& p, const
 }  // namespace
 
 TEST(UniformGrid, ModelAndCpuAreExactOnAdversarialScenesForEveryCellSize) {
-  ModelBackend model(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES);
+  ModelBackend model(builtDeviceParams());
   CpuBackend cpu;
   for (std::size_t n : {0u, 1u, 2u, 7u, 150u, 600u})
     for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 11)) {
@@ -307,7 +310,7 @@ TEST(UniformGrid, CoversCellsAboveTheCapacityInChunksExactly) {
   // Cells of about 20 boxes on a device that holds 4 or 6: every cell is chunked.
   const std::vector<Aabb> boxes = scatteredBoxes(300, 8, -20, 20, 0.5f, 3);
   for (std::size_t capacity : {2u, 4u, 6u, 16u}) {
-    ModelBackend small(2, capacity, 5);
+    ModelBackend small(DeviceParams::seed(2, capacity, 5));
     BroadPhase bp(small, 40, 1, PartitionKind::UniformGrid);
     std::vector<Pair> pairs;
     bp.findPairs(boxes, pairs);
@@ -320,7 +323,7 @@ TEST(UniformGrid, CoversCellsAboveTheCapacityInChunksExactly) {
 }
 
 TEST(UniformGrid, BatchesAndThreadsGiveExactlyTheBruteForcePairs) {
-  ModelBackend model(2, 6, 5);
+  ModelBackend model(DeviceParams::seed(2, 6, 5));
   for (std::size_t n : {0u, 2u, 300u, 1000u})
     for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 3)) {
       const auto exact = bruteForce(boxes);
@@ -328,7 +331,7 @@ TEST(UniformGrid, BatchesAndThreadsGiveExactlyTheBruteForcePairs) {
       BroadPhase batched(model, 16, 7, PartitionKind::UniformGrid);
       batched.findPairs(boxes, pairs);
       EXPECT_EQ(sorted(pairs), exact) << name << " batched";
-      BroadPhase threaded([] { return std::make_unique<ModelBackend>(2, 6, 5); }, 16, 2, 5,
+      BroadPhase threaded([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, 16, 2, 5,
                           PartitionKind::UniformGrid);
       threaded.findPairs(boxes, pairs);
       EXPECT_EQ(sorted(pairs), exact) << name << " 2 threads";
@@ -395,7 +398,7 @@ TEST(UniformGrid, IsExactOnBoxesAtTheEndsOfTheKeyRange) {
     keys.push_back(k);
   }
   CpuBackend cpu;
-  ModelBackend small(2, 6, 5);
+  ModelBackend small(DeviceParams::seed(2, 6, 5));
   for (Backend* backend : std::initializer_list<Backend*>{&cpu, &small})
     for (std::size_t cell : {1u, 4u, 32u}) {
       BroadPhase bp(*backend, cell, 1, PartitionKind::UniformGrid);

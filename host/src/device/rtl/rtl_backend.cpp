@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "../cpu_backend.hpp"
+#include "../model_backend.hpp"
 #include "VBroadPhaseAccel.h"
 #include "bpaccel_params.h"
 #include "verilated.h"
@@ -93,21 +95,12 @@ std::string RtlBackend::architecture() { return BPACCEL_ARCH; }
 bool RtlBackend::bipartite() const { return BPACCEL_BIPARTITE_RUNS != 0; }
 unsigned RtlBackend::keyWidth() const { return BPACCEL_KEY_WIDTH; }
 
-ModelBackend modelOfBuiltHardware(std::optional<unsigned> keyWidth) {
-  return ModelBackend(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES, BPACCEL_READ_LATENCY,
-                      BPACCEL_BATCH_CELLS, BPACCEL_BATCH_OVERLAPS_LOADS != 0, keyWidth.value_or(BPACCEL_KEY_WIDTH));
-}
-
 std::unique_ptr<Backend> makeBuiltBackend(const std::string& name) {
   if (name == "rtl") return std::make_unique<RtlBackend>();
-  if (name == "model") return std::make_unique<ModelBackend>(modelOfBuiltHardware());
+  if (name == "model") return std::make_unique<ModelBackend>(builtDeviceParams());
   if (name == "cpu") return std::make_unique<CpuBackend>();
   throw std::invalid_argument(fmt::format("no backend named '{}' (rtl, model or cpu)", name));
 }
-
-std::size_t resultBeatBytesOfBuiltHardware() { return (2 * BPACCEL_INDEX_WIDTH + BPACCEL_M + 7) / 8; }
-
-std::size_t loadBoxBytesOfBuiltHardware() { return loadBoxBytes(BPACCEL_KEY_WIDTH); }
 
 void RtlBackend::settle() {
   top_->clock = 0;

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "../backend.hpp"
+#include "../built_device.hpp"
 
 class VBroadPhaseAccel;
 class VerilatedContext;
@@ -65,16 +66,8 @@ class RtlBackend final : public Backend {
   std::function<bool(std::uint64_t)> consumerReady_;
 };
 
-/// The C++ model of exactly the hardware this host was built with; with
-/// `keyWidth`, of the same hardware at that key width (what narrower keys
-/// would cost the host, without building it: frame_timing).
-ModelBackend modelOfBuiltHardware(std::optional<unsigned> keyWidth = std::nullopt);
-/// The backend `name` ("rtl", "model" or "cpu") on the hardware this host was
-/// built with; throws std::invalid_argument for another name.
+/// The backend `name` ("rtl", "model" or "cpu") of the hardware this host was
+/// built with (builtDeviceParams); throws std::invalid_argument for another name.
 std::unique_ptr<Backend> makeBuiltBackend(const std::string& name);
-/// Bytes of one result beat of that hardware ({iBase, jBase, mask[m]}), for the link model.
-std::size_t resultBeatBytesOfBuiltHardware();
-/// Bytes of one box on that hardware's load port (six keys of BPACCEL_KEY_WIDTH bits), for the link model.
-std::size_t loadBoxBytesOfBuiltHardware();
 
 }  // namespace bpaccel

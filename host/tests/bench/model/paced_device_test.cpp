@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "device/model_backend.hpp"
 #include "device/backend.hpp"
 #include "broad_phase/broad_phase.hpp"
 #include "model/paced_device.hpp"
@@ -38,8 +39,8 @@ std::vector<std::span<const KeyBox>> spansOf(const std::vector<std::vector<KeyBo
 
 TEST(RecordingDevice, GivesTheInnerBackendsAnswerAndRecordsEachHandOversOwn) {
   AnswerRecording recording;
-  RecordingDevice recorder(std::make_unique<ModelBackend>(2, 64, 5), recording);
-  ModelBackend plain(2, 64, 5);
+  RecordingDevice recorder(std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)), recording);
+  ModelBackend plain(DeviceParams::seed(2, 64, 5));
   const auto cells = someCells();
   std::vector<Pair> got, expected;
   std::vector<std::size_t> gotEnds, expectedEnds;
@@ -63,8 +64,8 @@ TEST(RecordingDevice, GivesTheInnerBackendsAnswerAndRecordsEachHandOversOwn) {
 
 TEST(PacedDevice, AnswersWithTheRecordingNoSoonerThanItsModelledTime) {
   AnswerRecording recording;
-  ModelBackend model(2, 64, 5);
-  RecordingDevice recorder(std::make_unique<ModelBackend>(2, 64, 5), recording);
+  ModelBackend model(DeviceParams::seed(2, 64, 5));
+  RecordingDevice recorder(std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)), recording);
   const auto cells = someCells();
   std::vector<Pair> recorded;
   std::vector<std::size_t> recordedEnds;
@@ -108,7 +109,7 @@ TEST(PacedDevice, AnswersWithTheRecordingNoSoonerThanItsModelledTime) {
 TEST(PacedBroadPhase, PolledHandOversAgainstThePacedDeviceGiveTheRecordedFramesPairs) {
   for (const auto& [name, boxes] : adversarialScenes(600, 31)) {
     AnswerRecording recording;
-    RecordingDevice recorder(std::make_unique<ModelBackend>(2, 64, 5), recording);
+    RecordingDevice recorder(std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)), recording);
     BroadPhase sync(recorder, 16, 8, PartitionKind::UniformGrid);
     sync.setFirstBatchCells(2);
     PacedBroadPhase polled(recording, recorder, PipelineModel{}, 16, 8, 2, PartitionKind::UniformGrid);
