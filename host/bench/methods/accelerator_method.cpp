@@ -33,12 +33,18 @@ AcceleratorMethod::AcceleratorMethod(std::shared_ptr<const DeviceConfig> device,
     : device_(std::move(device)),
       recording_(device_->paced ? std::make_unique<AnswerRecording>() : nullptr),
       backend_(recordedBackend(*device_, recording_.get())),
-      phase_(*backend_, cellSize, device_->cellsPerBatch, partition) {
-  if (device_->firstBatchCells) phase_.setFirstBatchCells(device_->firstBatchCells);
+      phase_(*backend_, {.cellSize = cellSize,
+                         .partition = partition,
+                         .cellsPerBatch = device_->cellsPerBatch,
+                         .firstBatchCells = device_->firstBatchCells,
+                         .observer = &timing_}) {
   // Its batches need at least two cells (BroadPhase refuses fewer).
-  if (device_->paced)
-    pacedPhase_ = std::make_unique<PacedBroadPhase>(*recording_, *backend_, pipelineModel(), cellSize,
-                                                    device_->cellsPerBatch, phase_.firstBatchCells(), partition);
+  if (device_->paced) {
+    BroadPhaseConfig paced = phase_.config();
+    paced.handOvers = HandOvers::Polled;
+    paced.observer = nullptr;  // the paced run is timed as a whole
+    pacedPhase_ = std::make_unique<PacedBroadPhase>(*recording_, *backend_, pipelineModel(), paced);
+  }
 }
 
 void AcceleratorMethod::update(std::span<const Aabb> boxes) {
@@ -56,11 +62,11 @@ PipelineModel AcceleratorMethod::pipelineModel() const {
 FrameTime AcceleratorMethod::frameTime(double measuredSeconds) const {
   ModelledParts p;
   p.stats = phase_.stats();
-  p.hostSeconds = measuredSeconds - phase_.times().backendSeconds;  // simulating the device is not host work
-  p.partitionSeconds = phase_.times().partitionSeconds;
+  p.hostSeconds = measuredSeconds - timing_.times().backendSeconds;  // simulating the device is not host work
+  p.partitionSeconds = timing_.times().partitionSeconds;
   p.deviceSeconds = static_cast<double>(p.stats.deviceCycles()) / device_->clockHz;
   p.transferSeconds = device_->link.seconds(p.stats, device_->beatBytes, device_->clockHz);
-  p.pipeline = std::make_shared<const FrameTimeline>(modelPipeline(phase_.runs(), p.hostSeconds, pipelineModel()));
+  p.pipeline = std::make_shared<const FrameTimeline>(modelPipeline(timing_.handOvers(), p.hostSeconds, pipelineModel()));
   return {p.hostSeconds + p.deviceSeconds + p.transferSeconds, p};
 }
 

@@ -64,7 +64,7 @@ struct DeviceConfig {
   /// 1 hands each cell over on its own, as before batches existed.
   std::size_t cellsPerBatch = 1;
   /// Cells of a frame's first hand-over, doubling up to cellsPerBatch
-  /// (BroadPhase::setFirstBatchCells); 0: every hand-over holds cellsPerBatch.
+  /// (BroadPhaseConfig::firstBatchCells); 0: every hand-over holds cellsPerBatch.
   std::size_t firstBatchCells = 0;
   /// Each frame also runs paced (TimedMethod::runPaced): the host's polled
   /// asynchronous hand-overs (HandOvers::Polled) against a PacedDevice that
@@ -97,6 +97,7 @@ class AcceleratorMethod final : public TimedMethod {
   std::shared_ptr<const DeviceConfig> device_;
   std::unique_ptr<AnswerRecording> recording_;  // with paced runs: the last update's answers
   std::unique_ptr<Backend> backend_;
+  LastFrameTiming timing_;  // each update's, for the frame's parts and its pipeline
   BroadPhase phase_;
   // After the recording and the recorded backend, which its device thread reads: it goes first.
   std::unique_ptr<PacedBroadPhase> pacedPhase_;
@@ -109,7 +110,8 @@ class CpuMethod final : public TimedMethod {
  public:
   explicit CpuMethod(std::optional<std::size_t> cellSize, std::size_t threads = 1,
                      PartitionKind partition = PartitionKind::KdTree)
-      : phase_([] { return std::make_unique<CpuBackend>(); }, cellSize, threads, 1, partition) {}
+      : phase_([] { return std::make_unique<CpuBackend>(); },
+               {.cellSize = cellSize, .partition = partition, .threads = threads}) {}
   void update(std::span<const Aabb> boxes) override { phase_.findPairs(boxes, pairs_); }
   void pairs(std::vector<Pair>& out) override { out = pairs_; }
 

@@ -74,9 +74,9 @@ void PacedDevice::runBatch(std::span<const std::span<const KeyBox>> cells, std::
 }
 
 PacedBroadPhase::PacedBroadPhase(const AnswerRecording& recording, const Backend& recorded,
-                                 const PipelineModel& model, std::optional<std::size_t> cellSize,
-                                 std::size_t cellsPerBatch, std::size_t firstBatchCells, PartitionKind partition,
-                                 HandOvers handOvers) {
+                                 const PipelineModel& model, const BroadPhaseConfig& config) {
+  if (config.handOvers == HandOvers::Synchronous || config.threads != 1)
+    throw std::invalid_argument("paced broad phase: one thread with asynchronous hand-overs");
   // Built on the device's thread while the constructor waits: the pointer is set when it returns.
   phase_ = std::make_unique<BroadPhase>(
       [&] {
@@ -84,8 +84,7 @@ PacedBroadPhase::PacedBroadPhase(const AnswerRecording& recording, const Backend
         device_ = device.get();
         return device;
       },
-      cellSize, 1, cellsPerBatch, partition, handOvers);
-  phase_->setFirstBatchCells(firstBatchCells);
+      config);
 }
 
 void PacedBroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) {

@@ -87,17 +87,16 @@ class PacedDevice final : public Backend {
   std::vector<double> lateSeconds_;
 };
 
-/// A broad phase whose batches go, with asynchronous hand-overs of kind
-/// `handOvers`, to a PacedDevice that replays `recording`: each frame it runs
-/// the boxes of the frame whose answers were last recorded, on the host's
-/// threads as they would drive a real device, with the device's durations
-/// emulated. `recorded` is the device that recorded them; the partition,
-/// cell size and batches must be the recording run's.
+/// A broad phase whose batches go, with the asynchronous hand-overs of
+/// `config` (Asynchronous or Polled), to a PacedDevice that replays
+/// `recording`: each frame it runs the boxes of the frame whose answers were
+/// last recorded, on the host's threads as they would drive a real device,
+/// with the device's durations emulated. `recorded` is the device that
+/// recorded them; the partition, cell size and batches must be the recording run's.
 class PacedBroadPhase {
  public:
   PacedBroadPhase(const AnswerRecording& recording, const Backend& recorded, const PipelineModel& model,
-                  std::optional<std::size_t> cellSize, std::size_t cellsPerBatch, std::size_t firstBatchCells,
-                  PartitionKind partition, HandOvers handOvers = HandOvers::Polled);
+                  const BroadPhaseConfig& config);
   /// Untimed, before a frame: the emulated device awake, as a card needs no
   /// waking (BroadPhase::awakenDevices).
   void awakenDevice() { phase_->awakenDevices(); }

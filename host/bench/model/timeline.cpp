@@ -43,7 +43,7 @@ class DeviceLanes {
 
 // HandOvers::Polled: one host thread produces and decodes, in the code's
 // order (BroadPhase::Worker::handOverPolled, decodeOldest, finish).
-FrameTimeline modelPolled(const std::vector<RunRecord>& runs, double hostSeconds, const PipelineModel& model) {
+FrameTimeline modelPolled(const std::vector<HandOverRecord>& runs, double hostSeconds, const PipelineModel& model) {
   FrameTimeline t;
   DeviceLanes lanes(model, t);
   std::vector<double> arrived;
@@ -79,7 +79,7 @@ FrameTimeline modelPolled(const std::vector<RunRecord>& runs, double hostSeconds
 
 }  // namespace
 
-FrameTimeline modelPipeline(const std::vector<RunRecord>& runs, double hostSeconds, const PipelineModel& model) {
+FrameTimeline modelPipeline(const std::vector<HandOverRecord>& runs, double hostSeconds, const PipelineModel& model) {
   if (!(model.clockHz > 0) || !(model.bandwidthBytesPerSecond > 0) || model.latencySeconds < 0)
     throw std::invalid_argument("pipeline model: clock and bandwidth must be positive, latency not negative");
   if (model.batchesInFlight < 1) throw std::invalid_argument("pipeline model: at least one batch in flight");
@@ -90,7 +90,7 @@ FrameTimeline modelPipeline(const std::vector<RunRecord>& runs, double hostSecon
   double waited = 0;         // the producer's waits for a free batch so far
   double decodeFree = 0, produceStart = 0;
   for (std::size_t i = 0; i < runs.size(); ++i) {
-    const RunRecord& r = runs[i];
+    const HandOverRecord& r = runs[i];
     // The producer no longer decodes: each run is ready that much earlier,
     // and as much later as it waited for room.
     double ready = std::max(0.0, r.readySeconds - decodedBefore) + waited;

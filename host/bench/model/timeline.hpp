@@ -5,7 +5,8 @@
 #include <cstddef>
 #include <vector>
 
-#include "broad_phase/hand_over_record.hpp"
+#include "broad_phase/broad_phase_config.hpp"
+#include "broad_phase/frame_observer.hpp"
 #include "core/types.hpp"
 
 namespace bpaccel {
@@ -61,6 +62,6 @@ struct FrameTimeline {
 
 /// `hostSeconds`: the frame's measured host time (device simulation excluded),
 /// decoding included, as the serial run spent it.
-FrameTimeline modelPipeline(const std::vector<RunRecord>& runs, double hostSeconds, const PipelineModel& model);
+FrameTimeline modelPipeline(const std::vector<HandOverRecord>& runs, double hostSeconds, const PipelineModel& model);
 
 }  // namespace bpaccel

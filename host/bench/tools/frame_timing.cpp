@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
   app.add_option("--partition", partition)->capture_default_str()->check(CLI::IsMember({"kd", "grid"}));
   app.add_option("--cells-per-batch", cellsPerBatch)->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--first-batch-cells", firstBatchCells,
-                 "Cells of each frame's first hand-over (BroadPhase::setFirstBatchCells); several: compared")
+                 "Cells of each frame's first hand-over (BroadPhaseConfig::firstBatchCells); several: compared")
       ->check(CLI::PositiveNumber);
   app.add_option("--clock-mhz", clockMHz, "Device clock of the modelled overlapped frame")->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -153,6 +153,7 @@ int main(int argc, char** argv) {
   // One configuration: its backend, its broad phase and its figures.
   struct Timed {
     std::unique_ptr<bpaccel::Backend> backend;
+    std::unique_ptr<bpaccel::LastFrameTiming> timing = std::make_unique<bpaccel::LastFrameTiming>();
     std::unique_ptr<bpaccel::BroadPhase> phase;
     std::vector<double> host, convert, part, cells, decode, pipelined;
     std::vector<double> allocations;  // after the first pass
@@ -163,6 +164,7 @@ int main(int argc, char** argv) {
     std::vector<std::vector<std::pair<double, double>>> modelledSpans;
     // --paced: the same configuration's asynchronous hand-overs on a paced device, of each kind.
     struct Paced {
+      bpaccel::LastFrameTiming timing;
       std::unique_ptr<bpaccel::PacedBroadPhase> phase;
       std::vector<double> wall, lastReady, waits, decode;
     };
@@ -184,17 +186,21 @@ int main(int argc, char** argv) {
       t.keyWidth = keyWidth;
       t.backend = makeBackend(keyWidth);
       if (paced) t.backend = std::make_unique<bpaccel::RecordingDevice>(std::move(t.backend), *t.recording);
-      t.phase = std::make_unique<bpaccel::BroadPhase>(*t.backend, cellSize, cellsPerBatch,
-                                                      bpaccel::parsePartitionKind(partition));
-      t.phase->setFirstBatchCells(first);
+      const bpaccel::BroadPhaseConfig config{.cellSize = cellSize,
+                                             .partition = bpaccel::parsePartitionKind(partition),
+                                             .cellsPerBatch = cellsPerBatch,
+                                             .firstBatchCells = first,
+                                             .observer = t.timing.get()};
+      t.phase = std::make_unique<bpaccel::BroadPhase>(*t.backend, config);
       if (paced) {
         bpaccel::PipelineModel deviceModel = model;
         deviceModel.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(keyWidth));
         for (const auto kind : {bpaccel::HandOvers::Asynchronous, bpaccel::HandOvers::Polled}) {
           auto run = std::make_unique<Timed::Paced>();
-          run->phase = std::make_unique<bpaccel::PacedBroadPhase>(*t.recording, *t.backend, deviceModel, cellSize,
-                                                                  cellsPerBatch, first,
-                                                                  bpaccel::parsePartitionKind(partition), kind);
+          bpaccel::BroadPhaseConfig pacedConfig = config;
+          pacedConfig.handOvers = kind;
+          pacedConfig.observer = &run->timing;
+          run->phase = std::make_unique<bpaccel::PacedBroadPhase>(*t.recording, *t.backend, deviceModel, pacedConfig);
           t.paced.push_back(std::move(run));
         }
       }
@@ -215,7 +221,7 @@ int main(int argc, char** argv) {
         const auto t0 = Clock::now();
         t.phase->findPairs(recorded[f], pairs);
         const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
-        const auto& times = t.phase->times();
+        const auto& times = t.timing->times();
         const double hostSeconds = wall - times.backendSeconds;
         t.host.push_back(hostSeconds);
         if (p > 0) t.allocations.push_back(static_cast<double>(gAllocations - allocationsBefore));
@@ -223,18 +229,18 @@ int main(int argc, char** argv) {
         t.part.push_back(times.partitionSeconds);
         t.cells.push_back(times.cellsSeconds - times.backendSeconds);
         double decoded = 0;
-        for (const auto& r : t.phase->runs()) decoded += r.decodeSeconds;
+        for (const auto& r : t.timing->handOvers()) decoded += r.decodeSeconds;
         t.decode.push_back(decoded);
         // The link carries the device's keys.
         model.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(t.keyWidth));
-        t.pipelined.push_back(bpaccel::modelPipeline(t.phase->runs(), hostSeconds, model).frameSeconds);
+        t.pipelined.push_back(bpaccel::modelPipeline(t.timing->handOvers(), hostSeconds, model).frameSeconds);
         bpaccel::PipelineModel polled = model;
         polled.decodeOnProducer = true;
-        const auto polledTimeline = bpaccel::modelPipeline(t.phase->runs(), hostSeconds, polled);
+        const auto polledTimeline = bpaccel::modelPipeline(t.timing->handOvers(), hostSeconds, polled);
         t.pipelinedPolled.push_back(polledTimeline.frameSeconds);
         t.modelledSpans.emplace_back();
         for (const auto& span : polledTimeline.device) t.modelledSpans.back().emplace_back(span.start, span.end);
-        t.lastReady.push_back(t.phase->runs().empty() ? 0 : t.phase->runs().back().readySeconds);
+        t.lastReady.push_back(t.timing->handOvers().empty() ? 0 : t.timing->handOvers().back().readySeconds);
         std::sort(pairs.begin(), pairs.end());
         if (pairs != exact[f]) {
           fmt::print(stderr, "frame_timing: frame {} pass {}: {} pairs, the exact set has {}\n", f, p, pairs.size(),
@@ -249,11 +255,11 @@ int main(int argc, char** argv) {
           run.phase->findPairs(recorded[f], pairs);
           run.wall.push_back(std::chrono::duration<double>(Clock::now() - p0).count());
           // When the producer handed its last batch over (waits for room left out).
-          const bpaccel::BroadPhase& phase = run.phase->phase();
-          run.lastReady.push_back(phase.runs().back().readySeconds);
-          run.waits.push_back(phase.times().backendSeconds);
+          const bpaccel::LastFrameTiming& timing = run.timing;
+          run.lastReady.push_back(timing.handOvers().back().readySeconds);
+          run.waits.push_back(timing.times().backendSeconds);
           double decoding = 0;
-          for (const auto& r : phase.runs()) decoding += r.decodeSeconds;
+          for (const auto& r : timing.handOvers()) decoding += r.decodeSeconds;
           run.decode.push_back(decoding);
           std::sort(pairs.begin(), pairs.end());
           if (pairs != exact[f]) {
@@ -275,11 +281,11 @@ int main(int argc, char** argv) {
     fmt::print("key_width {} first_batch_cells {} host_us {:.1f} convert_us {:.1f} partition_us {:.1f} "
                "cells_host_us {:.1f} (decode_us {:.1f}) pipelined_us_modelled {:.1f} (producer decoding: {:.1f}) "
                "at {} MHz; pairs {} hits {} runs {} batches {} device_cycles {} allocations/frame {}\n",
-               t.keyWidth, t.phase->firstBatchCells(), us(t.host), us(t.convert), us(t.part), us(t.cells), us(t.decode),
+               t.keyWidth, t.phase->config().firstBatch(), us(t.host), us(t.convert), us(t.part), us(t.cells), us(t.decode),
                us(t.pipelined), us(t.pipelinedPolled), clockMHz, pairs.size(), stats.hits, stats.runs, stats.batches,
                stats.deviceCycles(), median(t.allocations));
     for (const auto& run : t.paced) {
-      const bool polled = run->phase->phase().handOvers() == bpaccel::HandOvers::Polled;
+      const bool polled = run->phase->phase().config().handOvers == bpaccel::HandOvers::Polled;
       const std::string kind = polled ? "paced, polled" : "paced, decoder thread";
       const auto& modelled = polled ? t.pipelinedPolled : t.pipelined;
       const auto& late = run->phase->device().lateSeconds();
@@ -307,7 +313,7 @@ int main(int argc, char** argv) {
       std::vector<double> ratio;
       for (std::size_t i = 0; i < t.pipelined.size(); ++i) ratio.push_back(t.pipelined[i] / timed[0].pipelined[i]);
       fmt::print("  overlapped frame against key_width {} first_batch_cells {}: median ratio {:.3f}\n",
-                 timed[0].keyWidth, timed[0].phase->firstBatchCells(), median(ratio));
+                 timed[0].keyWidth, timed[0].phase->config().firstBatch(), median(ratio));
     }
   }
   return 0;

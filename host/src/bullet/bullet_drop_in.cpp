@@ -58,7 +58,7 @@ Broadphase::Broadphase(std::unique_ptr<Backend> backend, const BroadPhase::Backe
       throw BroadphaseError(fmt::format("bpaccel::Broadphase: {} threads need a backend each: pass a backend factory",
                                         options_.threads));
     backendName_ = backend_->name();
-    broadPhase_ = std::make_unique<BroadPhase>(*backend_, options_.cellSize);
+    broadPhase_ = std::make_unique<BroadPhase>(*backend_, BroadPhaseConfig{.cellSize = options_.cellSize});
   } else {
     if (!*makeBackend) throw BroadphaseError("bpaccel::Broadphase: empty backend factory");
     auto naming = [this, makeBackend]() {
@@ -67,7 +67,8 @@ Broadphase::Broadphase(std::unique_ptr<Backend> backend, const BroadPhase::Backe
       backendName_ = b->name();
       return b;
     };
-    broadPhase_ = std::make_unique<BroadPhase>(naming, options_.cellSize, options_.threads);
+    broadPhase_ = std::make_unique<BroadPhase>(
+        naming, BroadPhaseConfig{.cellSize = options_.cellSize, .threads = options_.threads});
   }
   if (pairCache == nullptr) ownedCache_ = std::make_unique<btHashedOverlappingPairCache>();
   cache_ = pairCache != nullptr ? pairCache : ownedCache_.get();

@@ -33,7 +33,7 @@ const std::vector<std::optional<std::size_t>> kCellSizes = {std::nullopt, 1, 2, 
 
 void expectExact(Backend& backend, const std::vector<Aabb>& boxes, std::optional<std::size_t> cell,
                  const std::string& what) {
-  BroadPhase bp(backend, cell);
+  BroadPhase bp(backend, {.cellSize = cell});
   std::vector<Pair> pairs;
   bp.findPairs(boxes, pairs);
   const std::string label = what + " backend " + backend.name() + " cell " + (cell ? std::to_string(*cell) : "none");
@@ -86,7 +86,7 @@ TEST(BroadPhase, CellsAboveTheCapacityRunAsBipartiteChunkPairsTestingEachPairOnc
   }
   ModelBackend stream(DeviceParams::stream(m, capacity, 3, 4, true)), seed(DeviceParams::seed(m, capacity, 3));
   for (Backend* backend : {static_cast<Backend*>(&stream), static_cast<Backend*>(&seed)}) {
-    BroadPhase bp(*backend, 16);
+    BroadPhase bp(*backend, {.cellSize = 16});
     std::vector<Pair> pairs;
     bp.findPairs(same, pairs);
     EXPECT_EQ(pairs.size(), 300u * 299u / 2u);
@@ -101,19 +101,20 @@ TEST(BroadPhase, CellsAboveTheCapacityRunAsBipartiteChunkPairsTestingEachPairOnc
   }
   EXPECT_LT(bipartiteIssue, triangularIssue * 7 / 10);  // small chunks: the 2m - 1 prefix per block weighs more
   // Asynchronous hand-overs run the bipartite runs in the same order with the same cycles.
-  BroadPhase sync(stream, 16, 5);
-  BroadPhase async([&] { return std::make_unique<ModelBackend>(DeviceParams::stream(m, capacity, 3, 4, true)); }, 16, 1, 5,
-                   PartitionKind::KdTree, HandOvers::Asynchronous);
+  LastFrameTiming syncTiming, asyncTiming;
+  BroadPhase sync(stream, {.cellSize = 16, .cellsPerBatch = 5, .observer = &syncTiming});
+  BroadPhase async([&] { return std::make_unique<ModelBackend>(DeviceParams::stream(m, capacity, 3, 4, true)); },
+                   {.cellSize = 16, .cellsPerBatch = 5, .handOvers = HandOvers::Asynchronous, .observer = &asyncTiming});
   std::vector<Pair> expected, pairs;
   sync.findPairs(same, expected);
   async.findPairs(same, pairs);
   EXPECT_EQ(pairs, expected);
   EXPECT_EQ(async.stats().deviceCycles(), sync.stats().deviceCycles());
-  EXPECT_EQ(async.runs().size(), sync.runs().size());
+  EXPECT_EQ(asyncTiming.handOvers().size(), syncTiming.handOvers().size());
   // The bipartite runs share hand-overs with the chunks (5 cells a batch), so
   // loads hide behind runs: fewer load cycles than the runs one by one.
   EXPECT_EQ(sync.stats().batches, (k + k * (k - 1) / 2 + 4) / 5);
-  BroadPhase oneByOne(stream, 16, 1);
+  BroadPhase oneByOne(stream, {.cellSize = 16, .cellsPerBatch = 1});
   oneByOne.findPairs(same, pairs);
   EXPECT_EQ(oneByOne.stats().batches, k + k * (k - 1) / 2);
   EXPECT_EQ(oneByOne.stats().issueCycles, sync.stats().issueCycles);
@@ -150,7 +151,7 @@ TEST(BroadPhase, DegenerateScenesFallBackToChunkedLeaves) {
   // All boxes identical: no plane splits them, so one leaf holds all 300.
   std::vector<Aabb> same(300, box(1, 1, 1, 2, 2, 2));
   ModelBackend small(DeviceParams::seed(4, 64, 5));
-  BroadPhase bp(small, 16);
+  BroadPhase bp(small, {.cellSize = 16});
   std::vector<Pair> pairs;
   bp.findPairs(same, pairs);
   EXPECT_EQ(bp.partition().cells().size(), 1u);
@@ -217,7 +218,7 @@ TEST(KdTree, ReportsAPairInSeveralLeavesOnlyOnce) {
   boxes.push_back(box(-200, -200, -200, 200, 200, 200));
   boxes.push_back(box(-150, -150, -150, 150, 150, 150));
   CpuBackend cpu;
-  BroadPhase bp(cpu, 8);
+  BroadPhase bp(cpu, {.cellSize = 8});
   std::vector<Pair> pairs;
   bp.findPairs(boxes, pairs);
   std::size_t sharing = 0;
@@ -234,7 +235,7 @@ TEST(KdTree, ReportsAPairInSeveralLeavesOnlyOnce) {
 
 TEST(BroadPhase, RejectsBadInputNamingTheObject) {
   CpuBackend cpu;
-  BroadPhase bp(cpu, 16);
+  BroadPhase bp(cpu, {.cellSize = 16});
   std::vector<Aabb> boxes = {box(0, 0, 0, 1, 1, 1), box(0, 0, 0, 1, 1, 1), box(3, 0, 0, 1, 1, 1)};
   std::vector<Pair> pairs;
   EXPECT_THROW(
@@ -302,9 +303,9 @@ TEST(AllPairsKernel, BoxesOverEveryKeyPairOnlyWithBoxesNotWithThePadding) {
 
 TEST(BroadPhase, SeveralThreadsGiveExactlyTheSinglePairs) {
   for (std::size_t threads : {2u, 3u}) {
-    BroadPhase cpu([] { return std::make_unique<CpuBackend>(); }, 8, threads);
+    BroadPhase cpu([] { return std::make_unique<CpuBackend>(); }, {.cellSize = 8, .threads = threads});
     // A small capacity: cells above it are chunked inside the workers.
-    BroadPhase model([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, 16, threads);
+    BroadPhase model([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, {.cellSize = 16, .threads = threads});
     EXPECT_EQ(cpu.threads(), threads);
     for (std::size_t n : {0u, 2u, 300u, 1000u})
       for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 7)) {
@@ -319,14 +320,14 @@ TEST(BroadPhase, SeveralThreadsGiveExactlyTheSinglePairs) {
 }
 
 TEST(BroadPhase, RejectsZeroThreadsAndAnEmptyFactory) {
-  EXPECT_THROW(BroadPhase([] { return std::make_unique<CpuBackend>(); }, 8, 0), std::invalid_argument);
-  EXPECT_THROW(BroadPhase([] { return std::unique_ptr<Backend>(); }, 8, 2), std::invalid_argument);
+  EXPECT_THROW(BroadPhase([] { return std::make_unique<CpuBackend>(); }, {.cellSize = 8, .threads = 0}), std::invalid_argument);
+  EXPECT_THROW(BroadPhase([] { return std::unique_ptr<Backend>(); }, {.cellSize = 8, .threads = 2}), std::invalid_argument);
 }
 
 TEST(ModelPipeline, OverlapsHostLinkAndDeviceAsWorkedOutByHand) {
   // 1 us a cycle, one box (24 bytes) a microsecond on the link, one beat a microsecond.
   PipelineModel model{1e6, 24e6, 0, 24, 24};
-  RunRecord first, second;
+  HandOverRecord first, second;
   first.readySeconds = 10e-6;
   first.decodeSeconds = 2e-6;
   first.stats.boxesSent = 4;
@@ -361,7 +362,7 @@ TEST(ModelPipeline, HoldsTheProducerBackWhileItsBatchesInFlightAreUndecoded) {
   PipelineModel model{1e6, 24e6, 0, 24, 24};
   EXPECT_EQ(model.batchesInFlight, kBatchesInFlight);  // the host's own bound by default
   model.batchesInFlight = 1;
-  RunRecord first, second;
+  HandOverRecord first, second;
   first.readySeconds = 10e-6;
   first.decodeSeconds = 2e-6;
   first.stats.boxesSent = 4;
@@ -390,7 +391,7 @@ TEST(ModelPipeline, HoldsTheProducerBackWhileItsBatchesInFlightAreUndecoded) {
 TEST(ModelPipeline, PolledDecodesOnTheProducerBetweenHandOversAsWorkedOutByHand) {
   // 1 us a cycle, one box a microsecond on the link, one beat a microsecond, no latency.
   PipelineModel model{1e6, 24e6, 0, 24, 24};
-  std::vector<RunRecord> runs(3);
+  std::vector<HandOverRecord> runs(3);
   runs[0].readySeconds = 10e-6;
   runs[0].decodeSeconds = 2e-6;
   runs[0].stats.boxesSent = 4;
@@ -435,7 +436,7 @@ TEST(ModelPipeline, NeverBeatsTheBusiestLaneNorLosesToTheSerialSum) {
   for (int trial = 0; trial < 400; ++trial) {
     model.batchesInFlight = 1 + trial % 4;  // however few batches the host may have out
     model.decodeOnProducer = trial % 8 >= 4;  // and whichever thread decodes
-    std::vector<RunRecord> runs(1 + rng() % 30);
+    std::vector<HandOverRecord> runs(1 + rng() % 30);
     double ready = 0, host = 0, device = 0, serial = 0;
     for (auto& r : runs) {
       ready += us(rng);
@@ -458,16 +459,17 @@ TEST(ModelPipeline, NeverBeatsTheBusiestLaneNorLosesToTheSerialSum) {
   }
 }
 
-TEST(BroadPhase, RecordsEveryRunInOrderWithItsOwnCounters) {
+TEST(BroadPhase, TellsItsObserverEveryHandOverInOrderWithItsOwnCounters) {
   ModelBackend small(DeviceParams::seed(4, 64, 5));
-  BroadPhase bp(small, 16);
+  LastFrameTiming timing;
+  BroadPhase bp(small, {.cellSize = 16, .observer = &timing});
   std::vector<Pair> pairs;
   const auto boxes = adversarialScenes(500, 21).front().second;
   bp.findPairs(boxes, pairs);
-  ASSERT_EQ(bp.runs().size(), bp.stats().runs);
+  ASSERT_EQ(timing.handOvers().size(), bp.stats().runs);
   RunStats sum;
   double last = 0;
-  for (const auto& r : bp.runs()) {
+  for (const auto& r : timing.handOvers()) {
     sum += r.stats;
     EXPECT_GE(r.readySeconds, last);
     EXPECT_GE(r.decodeSeconds, 0);
@@ -476,7 +478,14 @@ TEST(BroadPhase, RecordsEveryRunInOrderWithItsOwnCounters) {
   EXPECT_EQ(sum.cycles, bp.stats().cycles);
   EXPECT_EQ(sum.loadCycles, bp.stats().loadCycles);
   EXPECT_EQ(sum.boxesSent, bp.stats().boxesSent);
-  EXPECT_LE(last, bp.times().totalSeconds);
+  EXPECT_LE(last, timing.times().totalSeconds);
+  EXPECT_GT(timing.times().totalSeconds, 0);
+  // Without an observer nothing is timed; the pairs and counters are the same.
+  BroadPhase untimed(small, {.cellSize = 16});
+  std::vector<Pair> again;
+  untimed.findPairs(boxes, again);
+  EXPECT_EQ(again, pairs);
+  EXPECT_EQ(untimed.stats().deviceCycles(), bp.stats().deviceCycles());
 }
 
 namespace {
@@ -504,7 +513,7 @@ TEST(BroadPhase, CellsReachTheBackendWhileTheTreeIsStillBeingBuilt) {
   ModelBackend model(DeviceParams::seed(4, 64, 5));
   const BroadPhase* phase = nullptr;
   LeafCountingBackend counting(model, phase);
-  BroadPhase bp(counting, 16);
+  BroadPhase bp(counting, {.cellSize = 16});
   phase = &bp;
   const std::vector<Aabb> boxes = scatteredBoxes(2000, 9, -40, 40, 0, 2);
   std::vector<Pair> pairs;
@@ -576,10 +585,10 @@ TEST(BroadPhase, ScenesLargerThanTheCarryThresholdAreExactOnOneAndTwoThreads) {
   std::vector<Pair> exact, pairs;
   exactPairs(boxes, exact);
   CpuBackend cpu;
-  BroadPhase one(cpu, 64);
+  BroadPhase one(cpu, {.cellSize = 64});
   one.findPairs(boxes, pairs);
   EXPECT_EQ(sorted(pairs), exact);
-  BroadPhase two([] { return std::make_unique<CpuBackend>(); }, 64, 2);
+  BroadPhase two([] { return std::make_unique<CpuBackend>(); }, {.cellSize = 64, .threads = 2});
   two.findPairs(boxes, pairs);
   EXPECT_EQ(sorted(pairs), exact);
 }
@@ -594,14 +603,15 @@ TEST(BroadPhase, BatchesOfCellsGiveExactlyThePairsOfSingleRunsWithTheSameCycles)
                                  std::optional<std::size_t>{16}}) {
           const std::string label = name + " capacity " + std::to_string(capacity) + " cell " +
                                     (cell ? std::to_string(*cell) : "none");
-          BroadPhase single(model, cell, 1);
+          BroadPhase single(model, {.cellSize = cell, .cellsPerBatch = 1});
           std::vector<Pair> expected;
           single.findPairs(boxes, expected);
           EXPECT_EQ(sorted(expected), bruteForce(boxes)) << label;
           EXPECT_EQ(single.stats().batches, single.stats().runs) << label;
           // 1000 is more than the model's hardware batch (64 cells): it splits the hand-over.
           for (std::size_t perBatch : {2u, 7u, 64u, 1000u}) {
-            BroadPhase batched(model, cell, perBatch);
+            LastFrameTiming timing;
+            BroadPhase batched(model, {.cellSize = cell, .cellsPerBatch = perBatch, .observer = &timing});
             std::vector<Pair> pairs;
             batched.findPairs(boxes, pairs);
             EXPECT_EQ(sorted(pairs), sorted(expected)) << label << " per batch " << perBatch;
@@ -612,7 +622,7 @@ TEST(BroadPhase, BatchesOfCellsGiveExactlyThePairsOfSingleRunsWithTheSameCycles)
               EXPECT_EQ(s.batches, (s.runs + handOver - 1) / handOver) << label << " per batch " << perBatch;
             else
               EXPECT_GE(s.batches, (s.runs + handOver - 1) / handOver) << label << " per batch " << perBatch;
-            EXPECT_EQ(batched.runs().size(), (s.runs + perBatch - 1) / perBatch) << label;
+            EXPECT_EQ(timing.handOvers().size(), (s.runs + perBatch - 1) / perBatch) << label;
             // The same cells on the same device: the same pair tests and loads.
             EXPECT_EQ(s.issueCycles, single.stats().issueCycles) << label;
             EXPECT_EQ(s.boxesSent, single.stats().boxesSent) << label;
@@ -658,7 +668,7 @@ TEST(BroadPhase, BatchesReachTheDeviceInAscendingCellSizeSoThatTheirLoadsHide) {
     for (const std::size_t perBatch : {7u, 64u}) {
       const std::string label = std::string(partitionName(partition)) + " per batch " + std::to_string(perBatch);
       BatchRecordingBackend recording(stream);
-      BroadPhase bp(recording, 32, perBatch, partition);
+      BroadPhase bp(recording, {.cellSize = 32, .partition = partition, .cellsPerBatch = perBatch});
       std::vector<Pair> pairs;
       bp.findPairs(boxes, pairs);
       EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << label;
@@ -695,11 +705,15 @@ TEST(BroadPhase, SlowStartHandsOverFewCellsFirstThenTwiceAsManyEachTimeUpToTheBa
       const std::string label = std::string(partitionName(partition)) + " first " + std::to_string(first) +
                                 " per batch " + std::to_string(perBatch);
       BatchRecordingBackend recording(stream);
-      BroadPhase bp(recording, 32, perBatch, partition);
-      bp.setFirstBatchCells(first);
-      EXPECT_EQ(bp.firstBatchCells(), std::min(first, perBatch)) << label;
+      LastFrameTiming timing;
+      BroadPhase bp(recording, {.cellSize = 32,
+                                .partition = partition,
+                                .cellsPerBatch = perBatch,
+                                .firstBatchCells = first,
+                                .observer = &timing});
+      EXPECT_EQ(bp.config().firstBatch(), std::min(first, perBatch)) << label;
       ModelBackend plainModel(DeviceParams::stream(8, 256, 3, 4, true));
-      BroadPhase plain(plainModel, 32, perBatch, partition);
+      BroadPhase plain(plainModel, {.cellSize = 32, .partition = partition, .cellsPerBatch = perBatch});
       for (int frame = 0; frame < 2; ++frame) {  // each frame starts small again
         recording.batches.clear();
         std::vector<Pair> pairs, plainPairs;
@@ -718,14 +732,13 @@ TEST(BroadPhase, SlowStartHandsOverFewCellsFirstThenTwiceAsManyEachTimeUpToTheBa
         }
         EXPECT_LE(recording.batches.back().size(), expected) << label;
         EXPECT_EQ(cells + recording.batches.back().size(), bp.stats().runs) << label;
-        EXPECT_EQ(bp.runs().size(), recording.batches.size()) << label;
+        EXPECT_EQ(timing.handOvers().size(), recording.batches.size()) << label;
       }
     }
-  EXPECT_THROW(BroadPhase(stream, 32, 8).setFirstBatchCells(0), std::invalid_argument);
 }
 
 TEST(BroadPhase, BatchesWorkOnSeveralThreadsAndRejectZeroCellsPerBatch) {
-  BroadPhase model([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, 16, 2, 5);
+  BroadPhase model([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, {.cellSize = 16, .threads = 2, .cellsPerBatch = 5});
   for (std::size_t n : {0u, 2u, 300u, 1000u})
     for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 9)) {
       std::vector<Pair> pairs;
@@ -734,7 +747,7 @@ TEST(BroadPhase, BatchesWorkOnSeveralThreadsAndRejectZeroCellsPerBatch) {
       EXPECT_LE(model.stats().batches, model.stats().runs) << name;
     }
   ModelBackend m(DeviceParams::seed(2, 6, 5));
-  EXPECT_THROW(BroadPhase(m, 16, 0), std::invalid_argument);
+  EXPECT_THROW(BroadPhase(m, {.cellSize = 16, .cellsPerBatch = 0}), std::invalid_argument);
 }
 
 namespace {
@@ -814,8 +827,7 @@ TEST(AsyncBackend, RethrowsAFailedDeviceConstructionFromItsOwnConstructor) {
   EXPECT_THROW(AsyncBackend([]() -> std::unique_ptr<Backend> { throw std::runtime_error("no device"); }),
                std::runtime_error);
   EXPECT_THROW(AsyncBackend([] { return std::unique_ptr<Backend>(); }), std::invalid_argument);
-  EXPECT_THROW(BroadPhase([] { return std::make_unique<CpuBackend>(); }, 8, 1, 1, PartitionKind::KdTree,
-                          HandOvers::Asynchronous),
+  EXPECT_THROW(BroadPhase([] { return std::make_unique<CpuBackend>(); }, {.cellSize = 8, .partition = PartitionKind::KdTree, .cellsPerBatch = 1, .handOvers = HandOvers::Asynchronous}),
                std::invalid_argument);  // one cell per batch: nothing to overlap
 }
 
@@ -828,14 +840,22 @@ TEST(BroadPhase, AsynchronousAndPolledHandOversGiveTheSynchronousPairsCountersAn
           const std::string label = name + " n " + std::to_string(n) + " per batch " + std::to_string(perBatch) +
                                     (handOvers == HandOvers::Polled ? " polled" : " decoder thread");
           ModelBackend syncModel(DeviceParams::seed(2, 64, 5));
-          BroadPhase sync(syncModel, 16, perBatch, partition);
-          BroadPhase async([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)); }, 16, 1, perBatch, partition,
-                           handOvers);
-          EXPECT_EQ(async.handOvers(), handOvers);
-          if (perBatch == 64) {  // with a slow start (hand-overs of 3, 6, 12, ...) on both
-            sync.setFirstBatchCells(3);
-            async.setFirstBatchCells(3);
-          }
+          // With 64 a batch, a slow start (hand-overs of 3, 6, 12, ...) on both.
+          const std::size_t first = perBatch == 64 ? 3 : 0;
+          LastFrameTiming syncTiming, asyncTiming;
+          BroadPhase sync(syncModel, {.cellSize = 16,
+                                      .partition = partition,
+                                      .cellsPerBatch = perBatch,
+                                      .firstBatchCells = first,
+                                      .observer = &syncTiming});
+          BroadPhase async([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)); },
+                           {.cellSize = 16,
+                            .partition = partition,
+                            .cellsPerBatch = perBatch,
+                            .firstBatchCells = first,
+                            .handOvers = handOvers,
+                            .observer = &asyncTiming});
+          EXPECT_EQ(async.config().handOvers, handOvers);
           for (int frame = 0; frame < 2; ++frame) {  // the second frame reuses the in-flight buffers
             std::vector<Pair> expected, pairs;
             sync.findPairs(boxes, expected);
@@ -844,17 +864,18 @@ TEST(BroadPhase, AsynchronousAndPolledHandOversGiveTheSynchronousPairsCountersAn
             EXPECT_EQ(pairs, expected) << label;  // decoded in hand-over order, so in the same order
             EXPECT_EQ(async.stats().deviceCycles(), sync.stats().deviceCycles()) << label;
             EXPECT_EQ(async.stats().batches, sync.stats().batches) << label;
-            ASSERT_EQ(async.runs().size(), sync.runs().size()) << label;
-            for (std::size_t r = 0; r < sync.runs().size(); ++r)
-              EXPECT_EQ(async.runs()[r].stats.deviceCycles(), sync.runs()[r].stats.deviceCycles()) << label;
+            const auto& syncRecords = syncTiming.handOvers();
+            const auto& asyncRecords = asyncTiming.handOvers();
+            ASSERT_EQ(asyncRecords.size(), syncRecords.size()) << label;
+            for (std::size_t r = 0; r < syncRecords.size(); ++r)
+              EXPECT_EQ(asyncRecords[r].stats.deviceCycles(), syncRecords[r].stats.deviceCycles()) << label;
           }
         }
 }
 
 TEST(BroadPhase, AsynchronousAndPolledHandOversWorkOnSeveralThreads) {
   for (const HandOvers handOvers : {HandOvers::Asynchronous, HandOvers::Polled}) {
-    BroadPhase bp([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, 16, 2, 5, PartitionKind::KdTree,
-                  handOvers);
+    BroadPhase bp([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, {.cellSize = 16, .partition = PartitionKind::KdTree, .threads = 2, .cellsPerBatch = 5, .handOvers = handOvers});
     for (std::size_t n : {2u, 300u, 1000u})
       for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 23)) {
         std::vector<Pair> pairs;
@@ -870,8 +891,7 @@ TEST(BroadPhase, AsynchronousAndPolledHandOversPassADeviceFailureOnAndRecover) {
     for (std::size_t failAt : {1u, 2u, 3u}) {
       const std::string label = "failing hand-over " + std::to_string(failAt) +
                                 (handOvers == HandOvers::Polled ? " polled" : " decoder thread");
-      BroadPhase bp([failAt] { return std::make_unique<FailingModel>(failAt); }, 8, 1, 4, PartitionKind::KdTree,
-                    handOvers);
+      BroadPhase bp([failAt] { return std::make_unique<FailingModel>(failAt); }, {.cellSize = 8, .partition = PartitionKind::KdTree, .cellsPerBatch = 4, .handOvers = handOvers});
       std::vector<Pair> pairs;
       EXPECT_THROW(bp.findPairs(boxes, pairs), std::runtime_error) << label;
       bp.findPairs(boxes, pairs);  // the device answers again: the next frame is whole
@@ -901,7 +921,7 @@ TEST(BroadPhase, NarrowKeyDevicesGiveExactlyTheFullKeyPairs) {
                                      std::optional<std::size_t>{16}})
               for (const std::size_t perBatch : {1u, 8u}) {
                 const auto handOvers = perBatch > 1 ? HandOvers::Asynchronous : HandOvers::Synchronous;
-                BroadPhase bp(make, cell, 1, perBatch, partition, handOvers);
+                BroadPhase bp(make, {.cellSize = cell, .partition = partition, .cellsPerBatch = perBatch, .handOvers = handOvers});
                 std::vector<Pair> pairs;
                 bp.findPairs(boxes, pairs);
                 const std::string label = name + " n=" + std::to_string(n) + " width " + std::to_string(width) +

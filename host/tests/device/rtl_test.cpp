@@ -169,7 +169,7 @@ TEST(RtlBackend, IsExactThroughTheKdTreeAndAcrossChunks) {
   RtlBackend rtl;
   for (const auto& [name, boxes] : adversarialScenes(500, 8))
     for (std::optional<std::size_t> cell : {std::optional<std::size_t>{}, std::optional<std::size_t>{16}}) {
-      BroadPhase bp(rtl, cell);
+      BroadPhase bp(rtl, {.cellSize = cell});
       std::vector<Pair> pairs;
       bp.findPairs(boxes, pairs);
       EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << name;
@@ -178,7 +178,7 @@ TEST(RtlBackend, IsExactThroughTheKdTreeAndAcrossChunks) {
   std::vector<Aabb> many;
   for (std::size_t i = 0; i < BPACCEL_CAPACITY + BPACCEL_CAPACITY / 3; ++i)
     many.push_back(i % 7 == 0 ? box(0, 0, 0, 10, 10, 10) : box(1, 1, 1, 2, 2, 2));
-  BroadPhase bp(rtl, std::nullopt);
+  BroadPhase bp(rtl, {.cellSize = std::nullopt});
   std::vector<Pair> pairs;
   bp.findPairs(many, pairs);
   EXPECT_EQ(pairs.size(), many.size() * (many.size() - 1) / 2);
@@ -233,7 +233,7 @@ TEST(RtlBackend, BipartiteRunsAgreeWithTheModelAndTestOnlyAcrossTheSplit) {
 TEST(RtlBackend, IsExactThroughTheUniformGridAndAcrossChunks) {
   RtlBackend rtl;
   for (const auto& [name, boxes] : adversarialScenes(500, 8)) {
-    BroadPhase bp(rtl, 16, 1, PartitionKind::UniformGrid);
+    BroadPhase bp(rtl, {.cellSize = 16, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 1});
     std::vector<Pair> pairs;
     bp.findPairs(boxes, pairs);
     EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << name;
@@ -242,7 +242,7 @@ TEST(RtlBackend, IsExactThroughTheUniformGridAndAcrossChunks) {
   // spread over the scene: the grid keeps it (no fallback) and it is chunked.
   std::vector<Aabb> clustered = scatteredBoxes(200, 4, 0, 100, 0.5f, 2);
   for (std::size_t i = 0; i < BPACCEL_CAPACITY + 100; ++i) clustered.push_back(box(1, 1, 1, 2, 2, 2));
-  BroadPhase bp(rtl, 256, 1, PartitionKind::UniformGrid);
+  BroadPhase bp(rtl, {.cellSize = 256, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 1});
   std::vector<Pair> pairs;
   bp.findPairs(clustered, pairs);
   EXPECT_FALSE(dynamic_cast<const UniformGrid&>(bp.partition()).fellBack());
@@ -509,12 +509,11 @@ TEST(RtlBatch, RunsOnItsOwnThreadBehindAnAsyncBackendWithTheSameResults) {
   RtlBackend direct;
   const auto boxes = scatteredBoxes(3 * BPACCEL_M + 40, 31, 0.0f, 20.0f, 0.5f, 3.0f);
   std::vector<Pair> expected, pairs;
-  BroadPhase sync(direct, 2 * BPACCEL_M, 3);
+  BroadPhase sync(direct, {.cellSize = 2 * BPACCEL_M, .cellsPerBatch = 3});
   sync.findPairs(boxes, expected);
   {
     // The Verilated model is built, run and destroyed on the hand-overs' own thread.
-    BroadPhase async([] { return std::make_unique<RtlBackend>(); }, 2 * BPACCEL_M, 1, 3, PartitionKind::KdTree,
-                     HandOvers::Asynchronous);
+    BroadPhase async([] { return std::make_unique<RtlBackend>(); }, {.cellSize = 2 * BPACCEL_M, .partition = PartitionKind::KdTree, .cellsPerBatch = 3, .handOvers = HandOvers::Asynchronous});
     async.findPairs(boxes, pairs);
     EXPECT_EQ(pairs, expected);
     EXPECT_EQ(async.stats().deviceCycles(), sync.stats().deviceCycles());

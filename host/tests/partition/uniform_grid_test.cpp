@@ -24,7 +24,7 @@ const UniformGrid& gridOf(const BroadPhase& bp) { return dynamic_cast<const Unif
 
 void expectExactOnGrid(Backend& backend, const std::vector<Aabb>& boxes, std::size_t cell, const std::string& what,
                        const std::vector<Pair>& exact) {
-  BroadPhase bp(backend, cell, 1, PartitionKind::UniformGrid);
+  BroadPhase bp(backend, {.cellSize = cell, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 1});
   std::vector<Pair> pairs;
   bp.findPairs(boxes, pairs);
   EXPECT_EQ(sorted(pairs), exact) << what << " backend " << backend.name() << " cell " << cell;
@@ -311,7 +311,7 @@ TEST(UniformGrid, CoversCellsAboveTheCapacityInChunksExactly) {
   const std::vector<Aabb> boxes = scatteredBoxes(300, 8, -20, 20, 0.5f, 3);
   for (std::size_t capacity : {2u, 4u, 6u, 16u}) {
     ModelBackend small(DeviceParams::seed(2, capacity, 5));
-    BroadPhase bp(small, 40, 1, PartitionKind::UniformGrid);
+    BroadPhase bp(small, {.cellSize = 40, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 1});
     std::vector<Pair> pairs;
     bp.findPairs(boxes, pairs);
     EXPECT_FALSE(gridOf(bp).fellBack());
@@ -328,11 +328,10 @@ TEST(UniformGrid, BatchesAndThreadsGiveExactlyTheBruteForcePairs) {
     for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 3)) {
       const auto exact = bruteForce(boxes);
       std::vector<Pair> pairs;
-      BroadPhase batched(model, 16, 7, PartitionKind::UniformGrid);
+      BroadPhase batched(model, {.cellSize = 16, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 7});
       batched.findPairs(boxes, pairs);
       EXPECT_EQ(sorted(pairs), exact) << name << " batched";
-      BroadPhase threaded([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, 16, 2, 5,
-                          PartitionKind::UniformGrid);
+      BroadPhase threaded([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, {.cellSize = 16, .partition = PartitionKind::UniformGrid, .threads = 2, .cellsPerBatch = 5});
       threaded.findPairs(boxes, pairs);
       EXPECT_EQ(sorted(pairs), exact) << name << " 2 threads";
     }
@@ -342,7 +341,7 @@ TEST(UniformGrid, DegenerateScenesStayExactAndBounded) {
   CpuBackend cpu;
   // Every box at one point: no extent, one cell.
   const std::vector<Aabb> point(300, box(7, 7, 7, 7, 7, 7));
-  BroadPhase bp(cpu, 16, 1, PartitionKind::UniformGrid);
+  BroadPhase bp(cpu, {.cellSize = 16, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 1});
   std::vector<Pair> pairs;
   bp.findPairs(point, pairs);
   EXPECT_FALSE(gridOf(bp).fellBack());
@@ -369,7 +368,7 @@ TEST(UniformGrid, DegenerateScenesStayExactAndBounded) {
   // A flat scene: one axis has almost no extent, and the cell count stays near the target.
   std::vector<Aabb> flat = scatteredBoxes(4000, 9, -100, 100, 0.1f, 1);
   for (auto& b : flat) b.min[2] = 0, b.max[2] = 1e-6f;
-  BroadPhase flatPhase(cpu, 16, 1, PartitionKind::UniformGrid);
+  BroadPhase flatPhase(cpu, {.cellSize = 16, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 1});
   flatPhase.findPairs(flat, pairs);
   const auto r = gridOf(flatPhase).resolution();
   EXPECT_EQ(r[2], 1u);
@@ -401,7 +400,7 @@ TEST(UniformGrid, IsExactOnBoxesAtTheEndsOfTheKeyRange) {
   ModelBackend small(DeviceParams::seed(2, 6, 5));
   for (Backend* backend : std::initializer_list<Backend*>{&cpu, &small})
     for (std::size_t cell : {1u, 4u, 32u}) {
-      BroadPhase bp(*backend, cell, 1, PartitionKind::UniformGrid);
+      BroadPhase bp(*backend, {.cellSize = cell, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 1});
       std::vector<Pair> pairs;
       bp.findPairs(std::span<const KeyBox>(keys), pairs);
       EXPECT_EQ(sorted(pairs), bruteForceKeys(keys)) << backend->name() << " cell " << cell;
@@ -467,7 +466,7 @@ TEST(UniformGrid, BoxesExactlyOnEitherSideOfAPlaneJoinTheRightCells) {
   }
   expectCellsPartitionSpaceAndHoldExactlyTheirBoxes(grid, edited, "boxes on the planes");
   CpuBackend cpu;
-  BroadPhase bp(cpu, 16, 1, PartitionKind::UniformGrid);
+  BroadPhase bp(cpu, {.cellSize = 16, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 1});
   std::vector<Pair> pairs;
   bp.findPairs(std::span<const KeyBox>(edited), pairs);
   EXPECT_EQ(sorted(pairs), bruteForceKeys(edited));

@@ -110,10 +110,12 @@ TEST(PacedBroadPhase, PolledHandOversAgainstThePacedDeviceGiveTheRecordedFramesP
   for (const auto& [name, boxes] : adversarialScenes(600, 31)) {
     AnswerRecording recording;
     RecordingDevice recorder(std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)), recording);
-    BroadPhase sync(recorder, 16, 8, PartitionKind::UniformGrid);
-    sync.setFirstBatchCells(2);
-    PacedBroadPhase polled(recording, recorder, PipelineModel{}, 16, 8, 2, PartitionKind::UniformGrid);
-    EXPECT_EQ(polled.phase().handOvers(), HandOvers::Polled);
+    BroadPhaseConfig config{
+        .cellSize = 16, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 8, .firstBatchCells = 2};
+    BroadPhase sync(recorder, config);
+    config.handOvers = HandOvers::Polled;
+    PacedBroadPhase polled(recording, recorder, PipelineModel{}, config);
+    EXPECT_EQ(polled.phase().config().handOvers, HandOvers::Polled);
     for (int frame = 0; frame < 2; ++frame) {
       recording.clear();
       std::vector<Pair> expected, pairs;
