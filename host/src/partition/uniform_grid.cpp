@@ -32,6 +32,42 @@ float finiteValueOf(std::uint32_t key) {
 // The same as a double; places planes only.
 double valueOf(std::uint32_t key) { return static_cast<double>(finiteValueOf(key)); }
 
+// Cells per axis, unrounded, for `target` cells over a scene of `extent`
+// (world units per axis).
+std::array<double, 3> cellsPerAxis(double target, const std::array<double, 3>& extent) {
+  std::array<bool, 3> free{};  // axes whose cell count is still to be chosen
+  for (int a = 0; a < 3; ++a) free[a] = extent[a] > 0 && std::isfinite(extent[a]) && target > 1;
+  // Cubic cells of edge s = (volume / target)^(1/dims) over the free axes; an
+  // axis with less than one such edge (a flat scene) gets one cell and leaves
+  // the rest to the others, so the count stays near the target.
+  std::array<double, 3> want{1, 1, 1};
+  for (bool changed = true; changed;) {
+    changed = false;
+    double logVolume = 0, fixed = 1;
+    int dims = 0;
+    for (int a = 0; a < 3; ++a) {
+      if (free[a]) {
+        logVolume += std::log(extent[a]);
+        ++dims;
+      } else {
+        fixed *= want[a];
+      }
+    }
+    if (dims == 0) break;
+    const double logEdge = (logVolume - std::log(std::max(target / fixed, 1.0))) / dims;
+    for (int a = 0; a < 3; ++a) {
+      if (!free[a]) continue;
+      want[a] = std::exp(std::log(extent[a]) - logEdge);
+      if (want[a] < 1) {
+        want[a] = 1;
+        free[a] = false;
+        changed = true;
+      }
+    }
+  }
+  return want;
+}
+
 #if defined(__x86_64__)
 // The cell function (see UniformGrid) on four keys, each lane with its own
 // axis's constants. Every step is monotone in the key; nothing is NaN: the
@@ -143,6 +179,149 @@ __attribute__((target("avx2"))) std::size_t firstCellsAvx2(const KeyBox* boxes, 
 
 #endif
 
+// Calls f(cell, 1, below) for each cell of r but its first, `below` the
+// axes on which that cell lies above r's first (the box's min below it):
+// branch-free when r spans at most two cells an axis (boxes smaller than
+// cells, nearly every straddler), with f(any number, 0, any) for each of the
+// seven neighbours the box misses; else by loops. nx, ny: cells on x and y.
+template <typename Range, typename F>
+void forEachOtherCell(const Range& r, std::uint64_t nx, std::uint64_t ny, F&& f) {
+  const unsigned dx = r.last[0] - r.first[0], dy = r.last[1] - r.first[1], dz = r.last[2] - r.first[2];
+  if ((dx | dy | dz) <= 1) {
+    const std::uint64_t base = (std::uint64_t{r.first[2]} * ny + r.first[1]) * nx + r.first[0];
+    for (unsigned o = 1; o < 8; ++o) {
+      const unsigned ox = o & 1, oy = (o >> 1) & 1, oz = o >> 2;
+      const unsigned inside = static_cast<unsigned>(ox <= dx) & static_cast<unsigned>(oy <= dy) &
+                              static_cast<unsigned>(oz <= dz);
+      f(base + ox + oy * nx + oz * nx * ny, inside, o);
+    }
+    return;
+  }
+  for (std::uint32_t z = r.first[2]; z <= r.last[2]; ++z)
+    for (std::uint32_t y = r.first[1]; y <= r.last[1]; ++y)
+      for (std::uint32_t x = r.first[0]; x <= r.last[0]; ++x) {
+        const unsigned below = static_cast<unsigned>(x != r.first[0]) | static_cast<unsigned>(y != r.first[1]) << 1 |
+                               static_cast<unsigned>(z != r.first[2]) << 2;
+        if (below) f((z * ny + y) * nx + x, 1u, below);
+      }
+}
+
+// Where the first-cells loops write (see UniformGrid::countBoxes): each box's
+// first cell, counted, and the straddlers with their ranges. Passed by value
+// and the count of straddlers kept in a local, so that the loops' stores to
+// the counts are not taken to change them.
+template <typename Range>
+struct FirstCells {
+  std::uint64_t* counts;
+  std::uint32_t* firsts;
+  std::uint32_t* straddlers;
+  Range* ranges;
+  std::uint64_t nx, ny;
+  // Records box i's cells (`c`: its min's on x, y, z, then its max's) after
+  // `straddling` straddlers; returns how many are listed then.
+  std::size_t record(std::size_t i, const std::uint32_t* c, std::size_t straddling) const {
+    Range r;
+    for (int a = 0; a < 3; ++a) {
+      r.first[a] = static_cast<std::uint16_t>(c[a]);
+      r.last[a] = static_cast<std::uint16_t>(c[a + 3]);
+    }
+    const auto first = static_cast<std::uint32_t>((r.first[2] * ny + r.first[1]) * nx + r.first[0]);
+    firsts[i] = first;
+    ++counts[first];
+    // Appended branch-free: the slot is overwritten unless the box straddles.
+    straddlers[straddling] = static_cast<std::uint32_t>(i);
+    ranges[straddling] = r;
+    // Bitwise on integers, not on bools: no branch, and no warning from clang.
+    return straddling + static_cast<std::size_t>(static_cast<unsigned>(r.first[0] != r.last[0]) |
+                                                 static_cast<unsigned>(r.first[1] != r.last[1]) |
+                                                 static_cast<unsigned>(r.first[2] != r.last[2]));
+  }
+};
+
+#if defined(__x86_64__)
+// The first cells of as many boxes as the vector loops take: four a step
+// with AVX2 where the CPU has it, two a step with SSE2; returns the first box
+// left to the caller.
+template <typename Axis, typename Range>
+std::size_t firstCellsVector(std::span<const KeyBox> boxes, const std::array<Axis, 3>& axes,
+                             const FirstCells<Range> out, std::size_t& straddlingOut) {
+  std::size_t i = 0, straddling = straddlingOut;
+  static_assert(sizeof(KeyBox) == 24, "two boxes are three 16-byte vectors");
+  // The lanes' axes: x y z x | y z x y | z x y z.
+  __m128 fromHalf[3], scale[3], last[3];
+  for (int v = 0; v < 3; ++v) {
+    const auto lane = [&](int l) -> const Axis& { return axes[(4 * v + l) % 3]; };
+    fromHalf[v] = _mm_setr_ps(lane(0).fromHalf, lane(1).fromHalf, lane(2).fromHalf, lane(3).fromHalf);
+    scale[v] = _mm_setr_ps(lane(0).scale, lane(1).scale, lane(2).scale, lane(3).scale);
+    last[v] = _mm_setr_ps(lane(0).last, lane(1).last, lane(2).last, lane(3).last);
+  }
+  // The bench's scenes and any from float boxes without infinities have finite bounds.
+  bool finite = true;
+  for (const Axis& axis : axes) finite = finite && axis.keyLo >= kLowestFinite && axis.keyHi <= kHighestFinite;
+  if (cpuHasAvx2()) {
+    LaneConstants lc;
+    const std::uint32_t weights[3] = {1, static_cast<std::uint32_t>(out.nx),
+                                      static_cast<std::uint32_t>(out.nx * out.ny)};
+    for (int l = 0; l < 24; ++l) {
+      const Axis& axis = axes[l % 3];
+      lc.fromHalf[l] = axis.fromHalf;
+      lc.scale[l] = axis.scale;
+      lc.last[l] = axis.last;
+      lc.weight[l] = weights[l % 3];
+    }
+    i = finite ? firstCellsAvx2<false>(boxes.data(), boxes.size(), lc, out.counts, out.firsts, out.straddlers,
+                                       out.ranges, straddling)
+               : firstCellsAvx2<true>(boxes.data(), boxes.size(), lc, out.counts, out.firsts, out.straddlers,
+                                      out.ranges, straddling);
+  }
+  const auto twoAtATime = [&]<bool kAnyKey>() {
+    const auto* words = reinterpret_cast<const char*>(boxes.data());
+    for (; i + 2 <= boxes.size(); i += 2) {
+      alignas(16) std::array<std::uint32_t, 12> c;
+      for (int v = 0; v < 3; ++v) {
+        const __m128i keys = _mm_loadu_si128(reinterpret_cast<const __m128i*>(words + 24 * i + 16 * v));
+        _mm_store_si128(reinterpret_cast<__m128i*>(c.data() + 4 * v),
+                        cellsOf<kAnyKey>(keys, fromHalf[v], scale[v], last[v]));
+      }
+      straddling = out.record(i, c.data(), straddling);
+      straddling = out.record(i + 1, c.data() + 6, straddling);
+    }
+  };
+  if (finite)
+    twoAtATime.template operator()<false>();
+  else
+    twoAtATime.template operator()<true>();
+  straddlingOut = straddling;
+  return i;
+}
+
+// A box that spans at most two cells an axis (nearly every straddler) joins
+// the neighbours of its first cell that its pattern (bit a: two cells on axis
+// a) allows: per pattern, their entries in the order forEachOtherCell gives
+// them, as offsets from {first cell, id}; seven 16-byte stores and one add
+// each, the unused slots overwritten later. nx, ny: cells on x and y.
+struct JoinTable {
+  __m128i joins[8][7];
+  std::array<unsigned, 8> joined{};
+};
+
+template <typename Extra>
+JoinTable joinTable(std::uint64_t nx, std::uint64_t ny) {
+  static_assert(sizeof(Extra) == 16 && offsetof(Extra, id) == 8 && offsetof(Extra, below) == 12,
+                "an entry is {cell, id | below << 32}");
+  JoinTable t;
+  for (unsigned p = 0; p < 8; ++p) {
+    for (__m128i& j : t.joins[p]) j = _mm_setzero_si128();
+    for (unsigned o = 1; o < 8; ++o)
+      if ((o & ~p) == 0)
+        t.joins[p][t.joined[p]++] =
+            _mm_set_epi64x(static_cast<long long>(std::uint64_t{o} << 32),
+                           static_cast<long long>((o & 1) + ((o >> 1) & 1) * nx + (o >> 2) * nx * ny));
+  }
+  return t;
+}
+#endif
+
 }  // namespace
 
 std::uint32_t UniformGrid::Axis::cellOf(std::uint32_t key) const {
@@ -221,39 +400,8 @@ void UniformGrid::chooseResolution(std::span<const KeyBox> boxes, std::size_t ce
   // ceil(2n / cellSize) cells (at most 2n, so memory stays linear in n).
   const double target = std::ceil(2.0 * static_cast<double>(boxes.size()) / static_cast<double>(cellSize));
   std::array<double, 3> extent{};
-  std::array<bool, 3> free{};  // axes whose cell count is still to be chosen
-  for (int a = 0; a < 3; ++a) {
-    extent[a] = valueOf(hi[a]) - valueOf(lo[a]);
-    free[a] = extent[a] > 0 && std::isfinite(extent[a]) && target > 1;
-  }
-  // Cubic cells of edge s = (volume / target)^(1/dims) over the free axes; an
-  // axis with less than one such edge (a flat scene) gets one cell and leaves
-  // the rest to the others, so the count stays near the target.
-  std::array<double, 3> want{1, 1, 1};
-  for (bool changed = true; changed;) {
-    changed = false;
-    double logVolume = 0, fixed = 1;
-    int dims = 0;
-    for (int a = 0; a < 3; ++a) {
-      if (free[a]) {
-        logVolume += std::log(extent[a]);
-        ++dims;
-      } else {
-        fixed *= want[a];
-      }
-    }
-    if (dims == 0) break;
-    const double logEdge = (logVolume - std::log(std::max(target / fixed, 1.0))) / dims;
-    for (int a = 0; a < 3; ++a) {
-      if (!free[a]) continue;
-      want[a] = std::exp(std::log(extent[a]) - logEdge);
-      if (want[a] < 1) {
-        want[a] = 1;
-        free[a] = false;
-        changed = true;
-      }
-    }
-  }
+  for (int a = 0; a < 3; ++a) extent[a] = valueOf(hi[a]) - valueOf(lo[a]);
+  const std::array<double, 3> want = cellsPerAxis(target, extent);
   for (int a = 0; a < 3; ++a) {
     const double cells = std::clamp(std::round(want[a]), 1.0, static_cast<double>(kMaxCellsPerAxis));
     axes_[a].place(lo[a], hi[a], static_cast<std::uint32_t>(cells));
@@ -270,7 +418,11 @@ std::array<std::uint32_t, 3> UniformGrid::resolution() const {
 // mispredict. The cells of four boxes (24 keys) are computed at a time with
 // AVX2 where the CPU has it, of two with SSE2 for the rest.
 bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
-  const std::uint64_t nx = axes_[0].cells(), ny = axes_[1].cells();
+  countFirstCells(boxes);
+  return countOtherCells(boxes.size());
+}
+
+void UniformGrid::countFirstCells(std::span<const KeyBox> boxes) {
   // Grow only: value-initialising the tail again every frame would cost a pass.
   if (firstCell_.size() < boxes.size()) {
     firstCell_.resize(boxes.size());
@@ -278,73 +430,11 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
     straddlerRanges_.resize(boxes.size());
   }
   // Locals: the loop's stores cannot be seen to leave the members alone.
-  std::uint64_t* const counts = offsets_.data();
-  std::uint32_t* const firsts = firstCell_.data();
-  std::uint32_t* const straddlers = straddlers_.data();
-  Range* const ranges = straddlerRanges_.data();
-  std::size_t straddling = 0;
-  // `c`: box i's cells, its min's on x, y, z, then its max's.
-  const auto record = [&](std::size_t i, const std::uint32_t* c) {
-    Range r;
-    for (int a = 0; a < 3; ++a) {
-      r.first[a] = static_cast<std::uint16_t>(c[a]);
-      r.last[a] = static_cast<std::uint16_t>(c[a + 3]);
-    }
-    const auto first = static_cast<std::uint32_t>((r.first[2] * ny + r.first[1]) * nx + r.first[0]);
-    firsts[i] = first;
-    ++counts[first];
-    // Appended branch-free: the slot is overwritten unless the box straddles.
-    straddlers[straddling] = static_cast<std::uint32_t>(i);
-    ranges[straddling] = r;
-    // Bitwise on integers, not on bools: no branch, and no warning from clang.
-    straddling += static_cast<std::size_t>(static_cast<unsigned>(r.first[0] != r.last[0]) |
-                                           static_cast<unsigned>(r.first[1] != r.last[1]) |
-                                           static_cast<unsigned>(r.first[2] != r.last[2]));
-  };
-  std::size_t i = 0;
+  const FirstCells<Range> out{offsets_.data(), firstCell_.data(), straddlers_.data(), straddlerRanges_.data(),
+                              axes_[0].cells(), axes_[1].cells()};
+  std::size_t i = 0, straddling = 0;
 #if defined(__x86_64__)
-  static_assert(sizeof(KeyBox) == 24, "two boxes are three 16-byte vectors");
-  // The lanes' axes: x y z x | y z x y | z x y z.
-  __m128 fromHalf[3], scale[3], last[3];
-  for (int v = 0; v < 3; ++v) {
-    const auto lane = [&](int l) -> const Axis& { return axes_[(4 * v + l) % 3]; };
-    fromHalf[v] = _mm_setr_ps(lane(0).fromHalf, lane(1).fromHalf, lane(2).fromHalf, lane(3).fromHalf);
-    scale[v] = _mm_setr_ps(lane(0).scale, lane(1).scale, lane(2).scale, lane(3).scale);
-    last[v] = _mm_setr_ps(lane(0).last, lane(1).last, lane(2).last, lane(3).last);
-  }
-  // The bench's scenes and any from float boxes without infinities have finite bounds.
-  bool finite = true;
-  for (const Axis& axis : axes_) finite = finite && axis.keyLo >= kLowestFinite && axis.keyHi <= kHighestFinite;
-  if (cpuHasAvx2()) {
-    LaneConstants lc;
-    const std::uint32_t weights[3] = {1, static_cast<std::uint32_t>(nx), static_cast<std::uint32_t>(nx * ny)};
-    for (int l = 0; l < 24; ++l) {
-      const Axis& axis = axes_[l % 3];
-      lc.fromHalf[l] = axis.fromHalf;
-      lc.scale[l] = axis.scale;
-      lc.last[l] = axis.last;
-      lc.weight[l] = weights[l % 3];
-    }
-    i = finite ? firstCellsAvx2<false>(boxes.data(), boxes.size(), lc, counts, firsts, straddlers, ranges, straddling)
-             : firstCellsAvx2<true>(boxes.data(), boxes.size(), lc, counts, firsts, straddlers, ranges, straddling);
-  }
-  const auto twoAtATime = [&]<bool kAnyKey>() {
-    const auto* words = reinterpret_cast<const char*>(boxes.data());
-    for (; i + 2 <= boxes.size(); i += 2) {
-      alignas(16) std::array<std::uint32_t, 12> c;
-      for (int v = 0; v < 3; ++v) {
-        const __m128i keys = _mm_loadu_si128(reinterpret_cast<const __m128i*>(words + 24 * i + 16 * v));
-        _mm_store_si128(reinterpret_cast<__m128i*>(c.data() + 4 * v),
-                        cellsOf<kAnyKey>(keys, fromHalf[v], scale[v], last[v]));
-      }
-      record(i, c.data());
-      record(i + 1, c.data() + 6);
-    }
-  };
-  if (finite)
-    twoAtATime.template operator()<false>();
-  else
-    twoAtATime.template operator()<true>();
+  i = firstCellsVector(boxes, axes_, out, straddling);
 #endif
   for (; i < boxes.size(); ++i) {
     std::array<std::uint32_t, 6> c;
@@ -352,31 +442,23 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
       c[a] = axes_[a].cellOf(boxes[i].min[a]);
       c[a + 3] = axes_[a].cellOf(boxes[i].max[a]);
     }
-    record(i, c.data());
+    straddling = out.record(i, c.data(), straddling);
   }
   straddling_ = straddling;
-  // The straddlers' other cells, within the cap on entries, listed first
-  // (stores to consecutive slots, branch-free for nearly all), then counted.
-  const std::uint64_t cap = kMaxEntriesPerBox * boxes.size();
-  std::uint64_t entries = boxes.size();
+}
+
+// The straddlers' other cells, within the cap on entries, listed first
+// (stores to consecutive slots, branch-free for nearly all), then counted.
+bool UniformGrid::countOtherCells(std::size_t boxCount) {
+  const std::uint64_t nx = axes_[0].cells(), ny = axes_[1].cells();
+  std::uint64_t* const counts = offsets_.data();
+  const std::uint32_t* const straddlers = straddlers_.data();
+  const Range* const ranges = straddlerRanges_.data();
+  const std::uint64_t cap = kMaxEntriesPerBox * boxCount;
+  std::uint64_t entries = boxCount;
   std::size_t extra = 0;
 #if defined(__x86_64__)
-  // A box that spans at most two cells an axis (nearly every straddler)
-  // joins the neighbours of its first cell that its pattern (bit a: two
-  // cells on axis a) allows: per pattern, their entries in the order
-  // forEachOtherCell gives them, as offsets from {first cell, id}; seven
-  // 16-byte stores and one add each, the unused slots overwritten later.
-  static_assert(sizeof(Extra) == 16 && offsetof(Extra, id) == 8 && offsetof(Extra, below) == 12,
-                "an entry is {cell, id | below << 32}");
-  __m128i joins[8][7];
-  std::array<unsigned, 8> joined{};
-  for (unsigned p = 0; p < 8; ++p) {
-    for (__m128i& j : joins[p]) j = _mm_setzero_si128();
-    for (unsigned o = 1; o < 8; ++o)
-      if ((o & ~p) == 0)
-        joins[p][joined[p]++] = _mm_set_epi64x(static_cast<long long>(std::uint64_t{o} << 32),
-                                               static_cast<long long>((o & 1) + ((o >> 1) & 1) * nx + (o >> 2) * nx * ny));
-  }
+  const JoinTable table = joinTable<Extra>(nx, ny);
 #endif
   for (std::size_t k = 0; k < straddling_; ++k) {
     const Range& r = ranges[k];
@@ -384,14 +466,14 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
     const unsigned dx = r.last[0] - r.first[0], dy = r.last[1] - r.first[1], dz = r.last[2] - r.first[2];
     if ((dx | dy | dz) <= 1) {
       const unsigned p = dx | dy << 1 | dz << 2;
-      entries += joined[p];
+      entries += table.joined[p];
       if (entries > cap) return false;
       if (extras_.size() < extra + 7) extras_.resize(2 * extra + 16);
       const std::uint64_t base = (std::uint64_t{r.first[2]} * ny + r.first[1]) * nx + r.first[0];
       const __m128i at = _mm_set_epi64x(static_cast<long long>(straddlers[k]), static_cast<long long>(base));
       auto* const slots = reinterpret_cast<__m128i*>(extras_.data() + extra);
-      for (unsigned j = 0; j < 7; ++j) _mm_storeu_si128(slots + j, _mm_add_epi64(at, joins[p][j]));
-      extra += joined[p];
+      for (unsigned j = 0; j < 7; ++j) _mm_storeu_si128(slots + j, _mm_add_epi64(at, table.joins[p][j]));
+      extra += table.joined[p];
       continue;
     }
 #endif
@@ -403,7 +485,7 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
     if (extras_.size() < extra + std::max<std::uint64_t>(others, 7)) extras_.resize(2 * (extra + others) + 8);
     Extra* const slots = extras_.data();
     const std::uint32_t id = straddlers[k];
-    forEachOtherCell(r, [&](std::uint64_t cell, unsigned inside, unsigned below) {
+    forEachOtherCell(r, nx, ny, [&](std::uint64_t cell, unsigned inside, unsigned below) {
       slots[extra] = {cell, id, static_cast<std::uint8_t>(below)};
       extra += inside;
     });
@@ -411,29 +493,6 @@ bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
   extraCount_ = extra;
   for (const Extra& e : std::span<const Extra>(extras_).first(extraCount_)) ++counts[e.cell];
   return true;
-}
-
-template <typename F>
-void UniformGrid::forEachOtherCell(const Range& r, F&& f) const {
-  const std::uint64_t nx = axes_[0].cells(), ny = axes_[1].cells();
-  const unsigned dx = r.last[0] - r.first[0], dy = r.last[1] - r.first[1], dz = r.last[2] - r.first[2];
-  if ((dx | dy | dz) <= 1) {
-    const std::uint64_t base = (std::uint64_t{r.first[2]} * ny + r.first[1]) * nx + r.first[0];
-    for (unsigned o = 1; o < 8; ++o) {
-      const unsigned ox = o & 1, oy = (o >> 1) & 1, oz = o >> 2;
-      const unsigned inside = static_cast<unsigned>(ox <= dx) & static_cast<unsigned>(oy <= dy) &
-                              static_cast<unsigned>(oz <= dz);
-      f(base + ox + oy * nx + oz * nx * ny, inside, o);
-    }
-    return;
-  }
-  for (std::uint32_t z = r.first[2]; z <= r.last[2]; ++z)
-    for (std::uint32_t y = r.first[1]; y <= r.last[1]; ++y)
-      for (std::uint32_t x = r.first[0]; x <= r.last[0]; ++x) {
-        const unsigned below = static_cast<unsigned>(x != r.first[0]) | static_cast<unsigned>(y != r.first[1]) << 1 |
-                               static_cast<unsigned>(z != r.first[2]) << 2;
-        if (below) f((z * ny + y) * nx + x, 1u, below);
-      }
 }
 
 void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell,

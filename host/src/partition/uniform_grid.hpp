@@ -120,19 +120,14 @@ class UniformGrid final : public Partition {
   };
   // Counts each cell's boxes into offsets_; false when the boxes would join too many cells.
   bool countBoxes(std::span<const KeyBox> boxes);
+  void countFirstCells(std::span<const KeyBox> boxes);  // every box's first cell; the straddlers listed
+  bool countOtherCells(std::size_t boxCount);          // the straddlers' other cells, within the cap
   // Resolution, counts, cells and every item placed with its bits; false
   // when the grid falls back to the tree (fellBack_), which is then not built.
   bool place(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds* bounds);
   // The boxes of cells [from, to) gathered in cell order (packed_).
   void gather(std::span<const KeyBox> boxes, std::size_t from, std::size_t to);
   void chooseResolution(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds& bounds);
-  // Calls f(cell, 1, below) for each cell of r but its first, `below` the
-  // axes on which that cell lies above r's first (the box's min below it):
-  // branch-free when r spans at most two cells an axis (boxes smaller than
-  // cells, nearly every straddler), with f(any number, 0, any) for each of
-  // the seven neighbours the box misses; else by loops.
-  template <typename F>
-  void forEachOtherCell(const Range& r, F&& f) const;
   // A straddler's entry in one of its other cells.
   struct Extra {
     std::uint64_t cell;
