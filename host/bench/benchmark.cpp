@@ -12,7 +12,7 @@
 #include <fmt/format.h>
 
 #include "device/cpu_backend.hpp"
-#include "peers/bullet_broadphases.hpp"
+#include "peers/bullet_methods.hpp"
 #include "bullet/bullet_drop_in.hpp"
 #include "core/median.hpp"
 #include "step_timing.hpp"
@@ -220,12 +220,12 @@ nlohmann::json Benchmark::wholeSteps() {
   constexpr std::size_t kCell = 64;
   struct Candidate {
     std::string name;
-    BroadphaseFactory make;
+    BtBroadphaseFactory make;
   };
   const std::vector<Candidate> candidates = {
       {"btDbvtBroadphase", [] { return std::make_unique<btDbvtBroadphase>(); }},
-      {fmt::format("bpaccel::Broadphase, cpu backend, k-d {}", kCell),
-       [] { return std::make_unique<Broadphase>(std::make_unique<CpuBackend>(), BroadphaseOptions{kCell}); }}};
+      {fmt::format("bpaccel::BulletDropIn, cpu backend, k-d {}", kCell),
+       [] { return std::make_unique<BulletDropIn>(std::make_unique<CpuBackend>(), BulletDropInOptions{kCell}); }}};
   nlohmann::json methods = nlohmann::json::array();
   for (const auto& c : candidates) {
     progress_(fmt::format("whole step, n={}: {}", sc.objects, c.name));

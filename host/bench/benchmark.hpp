@@ -27,7 +27,7 @@ struct BenchConfig {
   /// the rest of the row and listed as skipped with the time it took.
   double maxMethodSeconds = 60;
   /// Whole-step comparison (full stepSimulation of the world with Bullet's
-  /// btDbvtBroadphase and with bpaccel::Broadphase on the cpu backend) at
+  /// btDbvtBroadphase and with bpaccel::BulletDropIn on the cpu backend) at
   /// this object count; 0: none.
   std::size_t wholeStepObjects = 0;
   std::size_t wholeStepFrames = 20;

@@ -13,7 +13,7 @@ double StepTimes::median() const {
   return bpaccel::median(stepSeconds);
 }
 
-StepTimes timeWholeSteps(const SceneConfig& scene, const BroadphaseFactory& makeBroadphase, std::size_t frames,
+StepTimes timeWholeSteps(const SceneConfig& scene, const BtBroadphaseFactory& makeBroadphase, std::size_t frames,
                          std::size_t warmup) {
   BouncingCubeScene world(scene, makeBroadphase());
   for (std::size_t f = 0; f < warmup; ++f) world.step();

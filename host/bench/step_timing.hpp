@@ -12,7 +12,7 @@
 
 namespace bpaccel {
 
-using BroadphaseFactory = std::function<std::unique_ptr<btBroadphaseInterface>()>;
+using BtBroadphaseFactory = std::function<std::unique_ptr<btBroadphaseInterface>()>;
 
 struct StepTimes {
   std::vector<double> stepSeconds;  // one per timed frame, in order (steady clock)
@@ -21,7 +21,7 @@ struct StepTimes {
 
 /// Builds the world from `scene` with the factory's broad phase, steps it
 /// `warmup` frames untimed, then times `frames` calls of stepSimulation.
-StepTimes timeWholeSteps(const SceneConfig& scene, const BroadphaseFactory& makeBroadphase, std::size_t frames,
+StepTimes timeWholeSteps(const SceneConfig& scene, const BtBroadphaseFactory& makeBroadphase, std::size_t frames,
                          std::size_t warmup);
 
 }  // namespace bpaccel

@@ -23,7 +23,7 @@ std::unique_ptr<Backend> recordedBackend(const DeviceConfig& device, AnswerRecor
   auto backend = device.makeBackend();
   if (!backend) throw std::invalid_argument("accelerator method: the device config gave no backend");
   if (!recording) return backend;
-  return std::make_unique<RecordingDevice>(std::move(backend), *recording);
+  return std::make_unique<RecordingBackend>(std::move(backend), *recording);
 }
 
 }  // namespace

@@ -13,7 +13,7 @@
 #include "device/cpu_backend.hpp"
 #include "device/backend.hpp"
 #include "broad_phase/broad_phase.hpp"
-#include "model/paced_device.hpp"
+#include "model/paced_backend.hpp"
 #include "timed_method.hpp"
 
 namespace bpaccel {
@@ -67,7 +67,7 @@ struct DeviceConfig {
   /// (BroadPhaseConfig::firstBatchCells); 0: every hand-over holds cellsPerBatch.
   std::size_t firstBatchCells = 0;
   /// Each frame also runs paced (TimedMethod::runPaced): the host's polled
-  /// asynchronous hand-overs (HandOvers::Polled) against a PacedDevice that
+  /// asynchronous hand-overs (HandOvers::Polled) against a PacedBackend that
   /// replays the frame's recorded answers in their modelled time. Needs
   /// cellsPerBatch of at least 2.
   bool paced = false;
@@ -75,8 +75,8 @@ struct DeviceConfig {
 
 /// BroadPhase on the device: host part measured, device and link modelled.
 /// With DeviceConfig::paced, the device's answers are recorded in update()
-/// (RecordingDevice) and runPaced() runs the frame again on a second broad
-/// phase with polled asynchronous hand-overs, against a PacedDevice.
+/// (RecordingBackend) and runPaced() runs the frame again on a second broad
+/// phase with polled asynchronous hand-overs, against a PacedBackend.
 class AcceleratorMethod final : public TimedMethod {
  public:
   AcceleratorMethod(std::shared_ptr<const DeviceConfig> device, std::optional<std::size_t> cellSize,

@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
                      "against a device emulated for its modelled time (needs --cells-per-batch of at least 2)")
       ->capture_default_str();
   benchCmd->add_option("--whole-step-objects", bench.wholeStepObjects,
-                       "Also time full stepSimulation calls with btDbvtBroadphase and bpaccel::Broadphase at this "
+                       "Also time full stepSimulation calls with btDbvtBroadphase and bpaccel::BulletDropIn at this "
                        "object count (0: not)")
       ->capture_default_str();
   benchCmd->add_option("--cpu-threads", lineUp.cpuThreads,

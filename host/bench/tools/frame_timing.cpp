@@ -17,7 +17,7 @@
 // (HandOvers::Asynchronous: the producer, the device's thread and a decoder
 // thread; HandOvers::Polled: the producer decodes, and it and the device's
 // thread poll instead of sleeping), against a device held for its modelled
-// time (PacedDevice), and prints each frame's measured wall time beside the
+// time (PacedBackend), and prints each frame's measured wall time beside the
 // modelled overlapped frame of the same kind: a check of the model against
 // the threads that run it. The paced device replays the model backend's
 // answers recorded in the synchronous run of the same frame; only its
@@ -49,7 +49,7 @@
 #include "broad_phase/broad_phase.hpp"
 #include "core/median.hpp"
 #include "exact_pairs.hpp"
-#include "model/paced_device.hpp"
+#include "model/paced_backend.hpp"
 #include "device/rtl/rtl_backend.hpp"
 #include "scene.hpp"
 #include "model/timeline.hpp"
@@ -185,7 +185,7 @@ int main(int argc, char** argv) {
       Timed t;
       t.keyWidth = keyWidth;
       t.backend = makeBackend(keyWidth);
-      if (paced) t.backend = std::make_unique<bpaccel::RecordingDevice>(std::move(t.backend), *t.recording);
+      if (paced) t.backend = std::make_unique<bpaccel::RecordingBackend>(std::move(t.backend), *t.recording);
       const bpaccel::BroadPhaseConfig config{.cellSize = cellSize,
                                              .partition = bpaccel::parsePartitionKind(partition),
                                              .cellsPerBatch = cellsPerBatch,

@@ -1,5 +1,5 @@
 // Boxes dropped on a floor in a Bullet world whose broad phase is
-// bpaccel::Broadphase (the accelerator's C++ model as backend). Exits 0 when
+// bpaccel::BulletDropIn (the accelerator's C++ model as backend). Exits 0 when
 // every box comes to rest on the floor, which needs every box-floor and
 // box-box pair found.
 #include <cmath>
@@ -17,7 +17,7 @@ int main() {
   btDefaultCollisionConfiguration config;
   btCollisionDispatcher dispatcher(&config);
   // In place of `btDbvtBroadphase broadphase;`:
-  bpaccel::Broadphase broadphase(
+  bpaccel::BulletDropIn broadphase(
       std::make_unique<bpaccel::ModelBackend>(bpaccel::builtDeviceParams()));
   btSequentialImpulseConstraintSolver solver;
   btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);

@@ -52,7 +52,7 @@ BroadPhase::BroadPhase(const BroadPhaseConfig& config, const std::function<std::
     : config_(config) {
   config_.check();
   for (std::size_t t = 0; t < config_.threads; ++t) workers_.push_back(makeWorker());
-  capacity_ = workers_.front()->device().capacity;
+  capacity_ = workers_.front()->backend().capacity;
   if (capacity_ < 2) throw std::invalid_argument("broad phase: backend capacity must be at least 2");
   partition_ = makePartition(config_.partition);
   if (config_.threads > 1) pool_ = std::make_unique<Pool>(config_.threads);
@@ -193,7 +193,7 @@ void BroadPhase::finishCells(std::vector<Pair>& out) {
   for (auto& w : workers_) {
     if (workers_.size() > 1) out.insert(out.end(), w->pairs().begin(), w->pairs().end());
     stats_ += w->stats();
-    timing_.times.backendSeconds += w->timer().deviceSeconds();
+    timing_.times.backendSeconds += w->timer().backendSeconds();
     const auto& records = w->timer().records();
     timing_.handOvers.insert(timing_.handOvers.end(), records.begin(), records.end());
   }

@@ -37,8 +37,6 @@ class Worker;
 /// one hand-over to the device (one link latency).
 class BroadPhase {
  public:
-  using BackendFactory = std::function<std::unique_ptr<Backend>()>;
-
   /// One thread, synchronous hand-overs, on `backend` (which must outlive it).
   explicit BroadPhase(Backend& backend, const BroadPhaseConfig& config = {});
   /// config.threads workers, each with a device of its own from `makeBackend`.

@@ -7,7 +7,7 @@
 
 namespace bpaccel {
 
-DeviceTraits HandOver::traitsOf(const Backend& backend) {
+BackendTraits HandOver::traitsOf(const Backend& backend) {
   return {backend.name(), backend.capacity(), backend.bipartite(), backend.keyWidth()};
 }
 
@@ -29,13 +29,13 @@ std::unique_ptr<HandOver> HandOver::make(HandOvers kind, const BackendFactory& m
 
 SynchronousHandOver::SynchronousHandOver(Backend& backend, AnswerDecoder& decoder, HandOverTimer& timer)
     : HandOver(decoder, timer), backend_(backend) {
-  device_ = traitsOf(backend_);
+  traits_ = traitsOf(backend_);
 }
 
 SynchronousHandOver::SynchronousHandOver(std::unique_ptr<Backend> backend, AnswerDecoder& decoder,
                                          HandOverTimer& timer)
     : HandOver(decoder, timer), owned_(std::move(backend)), backend_(*owned_) {
-  device_ = traitsOf(backend_);
+  traits_ = traitsOf(backend_);
 }
 
 void SynchronousHandOver::runCell(const PairFilter& cell, std::span<const KeyBox> toDevice, std::size_t deviceSplit) {
@@ -54,7 +54,7 @@ void SynchronousHandOver::handOverBatch(Batch& batch, std::span<const std::span<
   local_.clear();
   cellEnds_.clear();
   timed([&](RunStats& stats) { backend_.runBatch(toDevice, batch.splits, local_, cellEnds_, stats); },
-        [&] { decoder_.decodeBatch(batch, local_, cellEnds_, device_.name); });
+        [&] { decoder_.decodeBatch(batch, local_, cellEnds_, traits_.name); });
   batch.clear();
 }
 
@@ -65,7 +65,7 @@ void SynchronousHandOver::timed(Run&& run, Decode&& decode) {
   record.readySeconds = timer_.readySeconds(ready);
   run(record.stats);
   const auto ran = timer_.now();
-  timer_.addDeviceTime(ready, ran);
+  timer_.addBackendTime(ready, ran);
   decoder_.addStats(record.stats);
   decode();
   record.decodeSeconds = FrameClock::seconds(ran, timer_.now());

@@ -18,7 +18,7 @@
 namespace bpaccel {
 
 /// What the broad phase needs to know of the device behind a hand-over.
-struct DeviceTraits {
+struct BackendTraits {
   std::string name;
   std::size_t capacity = 0;
   bool bipartite = false;
@@ -29,12 +29,11 @@ struct DeviceTraits {
 /// timing each hand-over with `timer` (both the worker's, which outlive it).
 class HandOver {
  public:
-  using BackendFactory = std::function<std::unique_ptr<Backend>()>;
   virtual ~HandOver() = default;
   HandOver(const HandOver&) = delete;
   HandOver& operator=(const HandOver&) = delete;
 
-  const DeviceTraits& device() const { return device_; }
+  const BackendTraits& backend() const { return traits_; }
   /// Before each frame: what a failed frame left with the device settled.
   virtual void startFrame() {}
   /// One cell on its own (cellsPerBatch 1, synchronous hand-overs only):
@@ -55,8 +54,8 @@ class HandOver {
 
  protected:
   HandOver(AnswerDecoder& decoder, HandOverTimer& timer) : decoder_(decoder), timer_(timer) {}
-  static DeviceTraits traitsOf(const Backend& backend);
-  DeviceTraits device_;
+  static BackendTraits traitsOf(const Backend& backend);
+  BackendTraits traits_;
   AnswerDecoder& decoder_;
   HandOverTimer& timer_;
 };

@@ -7,7 +7,7 @@ namespace bpaccel {
 namespace {
 
 // A device from the factory, refused if there is none.
-AsyncBackend::DeviceFactory checked(const HandOver::BackendFactory& makeBackend) {
+BackendFactory checked(const BackendFactory& makeBackend) {
   return [&makeBackend] {
     auto device = makeBackend();
     if (!device) throw std::invalid_argument("broad phase: the backend factory gave no backend");
@@ -20,7 +20,7 @@ AsyncBackend::DeviceFactory checked(const HandOver::BackendFactory& makeBackend)
 QueuedHandOver::QueuedHandOver(const BackendFactory& makeBackend, std::chrono::microseconds devicePoll,
                                AnswerDecoder& decoder, HandOverTimer& timer)
     : HandOver(decoder, timer), async_(checked(makeBackend), devicePoll) {
-  device_ = {async_.name(), async_.capacity(), async_.bipartite(), async_.keyWidth()};
+  traits_ = {async_.name(), async_.capacity(), async_.bipartite(), async_.keyWidth()};
 }
 
 QueuedHandOver::Slot& QueuedHandOver::submit(Batch& batch, std::span<const std::span<const KeyBox>> toDevice,
@@ -39,7 +39,7 @@ void QueuedHandOver::decodeAnswer(Slot& s) {
   BatchResult result = s.result.get();  // rethrows the device's failure
   const auto got = timer_.now();
   decoder_.addStats(result.stats);
-  decoder_.decodeBatch(s.batch, result.pairs, result.cellEnds, device_.name);
+  decoder_.decodeBatch(s.batch, result.pairs, result.cellEnds, traits_.name);
   s.record.stats = result.stats;
   s.record.decodeSeconds = FrameClock::seconds(got, timer_.now());
   timer_.record(s.record);
@@ -74,7 +74,7 @@ void AsynchronousHandOver::handOverBatch(Batch& batch, std::span<const std::span
   HandOverRecord record;
   record.readySeconds = timer_.readySeconds(ready);
   decoding_.waitForRoom();
-  timer_.addDeviceTimeSince(ready);
+  timer_.addBackendTimeSince(ready);
   Slot& s = submit(batch, toDevice, record);
   decoding_.post([this, &s] { decodeAnswer(s); });
 }
@@ -82,7 +82,7 @@ void AsynchronousHandOver::handOverBatch(Batch& batch, std::span<const std::span
 void AsynchronousHandOver::finish() {
   const auto waitFrom = timer_.now();
   decoding_.drain();  // every batch decoded; rethrows the first failure
-  timer_.addDeviceTimeSince(waitFrom);
+  timer_.addBackendTimeSince(waitFrom);
 }
 
 PolledHandOver::PolledHandOver(const BackendFactory& makeBackend, AnswerDecoder& decoder, HandOverTimer& timer)
@@ -126,7 +126,7 @@ void PolledHandOver::decodeOldest() {
     }
     pollPause();
   }
-  timer_.addDeviceTimeSince(from);
+  timer_.addBackendTimeSince(from);
   ++decoded_;  // first: a failure leaves the next one the oldest
   decodeAnswer(s);
 }

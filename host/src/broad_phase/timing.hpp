@@ -24,7 +24,7 @@ class FrameClock {
 };
 
 /// One worker's hand-overs of a frame: when each was ready, how long its
-/// decoding took, and the time spent in or waiting for the device (not host work).
+/// decoding took, and the time spent in or waiting for the backend (not host work).
 class HandOverTimer {
  public:
   using Clock = FrameClock::Clock;
@@ -33,27 +33,29 @@ class HandOverTimer {
   Clock::time_point now() const { return clock_.now(); }
   void startFrame(Clock::time_point start) {
     frameStart_ = start;
-    deviceSeconds_ = 0;
+    backendSeconds_ = 0;
     records_.clear();
   }
-  /// Host time from the frame's start to `t`, the device's time taken out.
-  double readySeconds(Clock::time_point t) const { return FrameClock::seconds(frameStart_, t) - deviceSeconds_; }
-  /// Time in or waiting for the device, from `from` to `to`.
-  void addDeviceTime(Clock::time_point from, Clock::time_point to) { deviceSeconds_ += FrameClock::seconds(from, to); }
+  /// Host time from the frame's start to `t`, the backend's time taken out.
+  double readySeconds(Clock::time_point t) const { return FrameClock::seconds(frameStart_, t) - backendSeconds_; }
+  /// Time in the backend or waiting for it (the device), from `from` to `to`: not host work.
+  void addBackendTime(Clock::time_point from, Clock::time_point to) {
+    backendSeconds_ += FrameClock::seconds(from, to);
+  }
   /// The same from `from` to now (a clock read only when on).
-  void addDeviceTimeSince(Clock::time_point from) {
-    if (on()) addDeviceTime(from, Clock::now());
+  void addBackendTimeSince(Clock::time_point from) {
+    if (on()) addBackendTime(from, Clock::now());
   }
   void record(const HandOverRecord& r) {
     if (on()) records_.push_back(r);
   }
-  double deviceSeconds() const { return deviceSeconds_; }
+  double backendSeconds() const { return backendSeconds_; }
   const std::vector<HandOverRecord>& records() const { return records_; }
 
  private:
   FrameClock clock_;
   Clock::time_point frameStart_{};
-  double deviceSeconds_ = 0;              // the producer's (written on its thread only)
+  double backendSeconds_ = 0;             // the producer's (written on its thread only)
   std::vector<HandOverRecord> records_;   // written by whichever thread decodes
 };
 

@@ -10,8 +10,8 @@ Worker::Worker(const MakeHandOver& makeHandOver, std::size_t cellsPerBatch, std:
     : cellsPerBatch_(cellsPerBatch),
       timer_(timed),
       handOver_(makeHandOver(decoder_, timer_)),
-      builder_(cellsPerBatch, firstBatchCells, handOver_->device().keyWidth) {
-  decoder_.setDeviceKeyWidth(handOver_->device().keyWidth);
+      builder_(cellsPerBatch, firstBatchCells, handOver_->backend().keyWidth) {
+  decoder_.setDeviceKeyWidth(handOver_->backend().keyWidth);
 }
 
 void Worker::startFrame(HandOverTimer::Clock::time_point start) {
@@ -24,12 +24,12 @@ void Worker::startFrame(HandOverTimer::Clock::time_point start) {
 void Worker::processCell(std::span<const KeyBox> keys, const DeviceCell& cell) {
   const std::size_t n = cell.items.size();
   if (n < 2) return;
-  const DeviceTraits& device = handOver_->device();
-  if (n <= device.capacity) {
+  const BackendTraits& backend = handOver_->backend();
+  if (n <= backend.capacity) {
     submit(keys, cell);
     return;
   }
-  planChunks(n, device.capacity, device.bipartite, plan_);
+  planChunks(n, backend.capacity, backend.bipartite, plan_);
   const auto chunk = [&](std::size_t p) {
     return cell.items.subspan(p * plan_.chunkSize, std::min(plan_.chunkSize, n - p * plan_.chunkSize));
   };
@@ -70,7 +70,7 @@ void Worker::runAlone(std::span<const KeyBox> keys, const DeviceCell& cell) {
     packed = gathered_;
   }
   std::span<const KeyBox> toDevice = packed;
-  if (const unsigned width = handOver_->device().keyWidth; width < 32) {
+  if (const unsigned width = handOver_->backend().keyWidth; width < 32) {
     narrowed_.resize(packed.size());
     narrowKeys(packed, width, narrowed_);
     toDevice = narrowed_;

@@ -28,7 +28,7 @@ class Worker {
   Worker(const Worker&) = delete;
   Worker& operator=(const Worker&) = delete;
 
-  const DeviceTraits& device() const { return handOver_->device(); }
+  const BackendTraits& backend() const { return handOver_->backend(); }
   /// Clears the last frame's results (after settling what a failed frame left).
   void startFrame(HandOverTimer::Clock::time_point start);
   /// A partition cell, or the whole scene: one device cell within the

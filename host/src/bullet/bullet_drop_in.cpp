@@ -14,9 +14,9 @@
 namespace bpaccel {
 
 // The keys are float32: a double-precision Bullet would round AABBs on the way in.
-static_assert(std::is_same_v<btScalar, float>, "bpaccel::Broadphase needs single-precision Bullet (btScalar = float)");
+static_assert(std::is_same_v<btScalar, float>, "bpaccel::BulletDropIn needs single-precision Bullet (btScalar = float)");
 
-struct Broadphase::Proxy : btBroadphaseProxy {
+struct BulletDropIn::Proxy : btBroadphaseProxy {
   std::uint32_t slot = 0;   // fixed for the storage's life; orders pair changes
   std::uint32_t dense = 0;  // index into boxes_ while live
   bool live = false;
@@ -38,32 +38,32 @@ std::string describe(const btBroadphaseProxy* proxy) {
 
 }  // namespace
 
-Broadphase::Broadphase(std::unique_ptr<Backend> backend, BroadphaseOptions options, btOverlappingPairCache* pairCache)
-    : Broadphase(std::move(backend), nullptr, options, pairCache) {}
+BulletDropIn::BulletDropIn(std::unique_ptr<Backend> backend, BulletDropInOptions options, btOverlappingPairCache* pairCache)
+    : BulletDropIn(std::move(backend), nullptr, options, pairCache) {}
 
-Broadphase::Broadphase(const BroadPhase::BackendFactory& makeBackend, BroadphaseOptions options,
+BulletDropIn::BulletDropIn(const BackendFactory& makeBackend, BulletDropInOptions options,
                        btOverlappingPairCache* pairCache)
-    : Broadphase(nullptr, &makeBackend, options, pairCache) {}
+    : BulletDropIn(nullptr, &makeBackend, options, pairCache) {}
 
-Broadphase::Broadphase(std::unique_ptr<Backend> backend, const BroadPhase::BackendFactory* makeBackend,
-                       BroadphaseOptions options, btOverlappingPairCache* pairCache)
+BulletDropIn::BulletDropIn(std::unique_ptr<Backend> backend, const BackendFactory* makeBackend,
+                       BulletDropInOptions options, btOverlappingPairCache* pairCache)
     : options_(options), backend_(std::move(backend)) {
   if (options_.maxProxies == 0 || options_.maxProxies > 0xFFFFFFFEull)
-    throw BroadphaseError(fmt::format("bpaccel::Broadphase: maxProxies must be in 1..{}, got {}", 0xFFFFFFFEull,
+    throw BulletDropInError(fmt::format("bpaccel::BulletDropIn: maxProxies must be in 1..{}, got {}", 0xFFFFFFFEull,
                                       options_.maxProxies));
-  if (options_.threads == 0) throw BroadphaseError("bpaccel::Broadphase: threads must be at least 1");
+  if (options_.threads == 0) throw BulletDropInError("bpaccel::BulletDropIn: threads must be at least 1");
   if (makeBackend == nullptr) {
-    if (!backend_) throw BroadphaseError("bpaccel::Broadphase: no backend given");
+    if (!backend_) throw BulletDropInError("bpaccel::BulletDropIn: no backend given");
     if (options_.threads != 1)
-      throw BroadphaseError(fmt::format("bpaccel::Broadphase: {} threads need a backend each: pass a backend factory",
+      throw BulletDropInError(fmt::format("bpaccel::BulletDropIn: {} threads need a backend each: pass a backend factory",
                                         options_.threads));
     backendName_ = backend_->name();
     broadPhase_ = std::make_unique<BroadPhase>(*backend_, BroadPhaseConfig{.cellSize = options_.cellSize});
   } else {
-    if (!*makeBackend) throw BroadphaseError("bpaccel::Broadphase: empty backend factory");
+    if (!*makeBackend) throw BulletDropInError("bpaccel::BulletDropIn: empty backend factory");
     auto naming = [this, makeBackend]() {
       std::unique_ptr<Backend> b = (*makeBackend)();
-      if (!b) throw BroadphaseError("bpaccel::Broadphase: the backend factory returned no backend");
+      if (!b) throw BulletDropInError("bpaccel::BulletDropIn: the backend factory returned no backend");
       backendName_ = b->name();
       return b;
     };
@@ -72,25 +72,28 @@ Broadphase::Broadphase(std::unique_ptr<Backend> backend, const BroadPhase::Backe
   }
   if (pairCache == nullptr) ownedCache_ = std::make_unique<btHashedOverlappingPairCache>();
   cache_ = pairCache != nullptr ? pairCache : ownedCache_.get();
+  cacheSync_ = std::make_unique<PairCacheSync>(
+      *cache_, [this](std::uint32_t slot) { return slots_[slot].get(); },
+      [this](const btBroadphasePair& pair) { return cachedKey(pair); });
 }
 
 // Like Bullet's broad phases, the pairs of proxies still alive are left in the
 // cache: a world removes its objects (and their pairs) before it drops the broad phase.
-Broadphase::~Broadphase() = default;
+BulletDropIn::~BulletDropIn() = default;
 
-Broadphase::Proxy& Broadphase::owned(btBroadphaseProxy* proxy, const char* what) const {
-  if (proxy == nullptr) throw BroadphaseError(fmt::format("{}: null proxy", what));
+BulletDropIn::Proxy& BulletDropIn::owned(btBroadphaseProxy* proxy, const char* what) const {
+  if (proxy == nullptr) throw BulletDropInError(fmt::format("{}: null proxy", what));
   // Only the base class's fields are read before the proxy is known to be ours.
   const long long slot = static_cast<long long>(proxy->m_uniqueId) - kUidOffset;
   if (slot < 0 || slot >= static_cast<long long>(slots_.size()) ||
       slots_[static_cast<std::size_t>(slot)].get() != proxy)
-    throw BroadphaseError(fmt::format("{}: {} was not created by this broad phase", what, describe(proxy)));
+    throw BulletDropInError(fmt::format("{}: {} was not created by this broad phase", what, describe(proxy)));
   Proxy& p = *slots_[static_cast<std::size_t>(slot)];
-  if (!p.live) throw BroadphaseError(fmt::format("{}: {} was already destroyed", what, describe(proxy)));
+  if (!p.live) throw BulletDropInError(fmt::format("{}: {} was already destroyed", what, describe(proxy)));
   return p;
 }
 
-Aabb Broadphase::checkedBox(const btVector3& aabbMin, const btVector3& aabbMax, const Proxy* proxy, const char* what) {
+Aabb BulletDropIn::checkedBox(const btVector3& aabbMin, const btVector3& aabbMax, const Proxy* proxy, const char* what) {
   static constexpr char kAxis[3] = {'x', 'y', 'z'};
   // Tested on keys, not floats: -ffast-math builds may fold isnan and float
   // compares with NaN. NaN keys lie outside [key(-inf), key(+inf)].
@@ -102,21 +105,21 @@ Aabb Broadphase::checkedBox(const btVector3& aabbMin, const btVector3& aabbMax, 
     const float lo = aabbMin[a], hi = aabbMax[a];
     const std::uint32_t loKey = floatToKey(lo), hiKey = floatToKey(hi);
     if (isNaN(loKey) || isNaN(hiKey))
-      throw BroadphaseError(fmt::format("{}: {} has NaN in its AABB on {} (min {}, max {})", what, describe(proxy),
+      throw BulletDropInError(fmt::format("{}: {} has NaN in its AABB on {} (min {}, max {})", what, describe(proxy),
                                         kAxis[a], lo, hi));
     if (loKey > hiKey)
-      throw BroadphaseError(fmt::format("{}: {} has min {} > max {} on {}", what, describe(proxy), lo, hi, kAxis[a]));
+      throw BulletDropInError(fmt::format("{}: {} has min {} > max {} on {}", what, describe(proxy), lo, hi, kAxis[a]));
     box.min[static_cast<std::size_t>(a)] = lo;
     box.max[static_cast<std::size_t>(a)] = hi;
   }
   return box;
 }
 
-btBroadphaseProxy* Broadphase::createProxy(const btVector3& aabbMin, const btVector3& aabbMax, int /*shapeType*/,
+btBroadphaseProxy* BulletDropIn::createProxy(const btVector3& aabbMin, const btVector3& aabbMax, int /*shapeType*/,
                                            void* userPtr, int collisionFilterGroup, int collisionFilterMask,
                                            btDispatcher* /*dispatcher*/) {
   if (boxes_.size() >= options_.maxProxies)
-    throw BroadphaseError(fmt::format("createProxy: this broad phase holds at most {} proxies (BroadphaseOptions::maxProxies)",
+    throw BulletDropInError(fmt::format("createProxy: this broad phase holds at most {} proxies (BulletDropInOptions::maxProxies)",
                                       options_.maxProxies));
   const Aabb box = checkedBox(aabbMin, aabbMax, nullptr, "createProxy");
   std::uint32_t slot;
@@ -142,12 +145,10 @@ btBroadphaseProxy* Broadphase::createProxy(const btVector3& aabbMin, const btVec
   return &p;
 }
 
-void Broadphase::destroyProxy(btBroadphaseProxy* proxy, btDispatcher* dispatcher) {
+void BulletDropIn::destroyProxy(btBroadphaseProxy* proxy, btDispatcher* dispatcher) {
   Proxy& p = owned(proxy, "destroyProxy");
   cache_->removeOverlappingPairsContainingProxy(&p, dispatcher);
-  std::erase_if(present_, [slot = p.slot](std::uint64_t key) {
-    return key >> 32 == slot || (key & 0xFFFFFFFFu) == slot;
-  });
+  cacheSync_->forget(p.slot);
   // Swap-remove from the dense arrays, moving the last box into the hole.
   const std::uint32_t last = static_cast<std::uint32_t>(boxes_.size() - 1);
   const std::uint32_t movedSlot = denseSlot_[last];
@@ -161,7 +162,7 @@ void Broadphase::destroyProxy(btBroadphaseProxy* proxy, btDispatcher* dispatcher
   freeSlots_.push_back(p.slot);
 }
 
-void Broadphase::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbMin, const btVector3& aabbMax,
+void BulletDropIn::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbMin, const btVector3& aabbMax,
                          btDispatcher* /*dispatcher*/) {
   Proxy& p = owned(proxy, "setAabb");
   boxes_[p.dense] = checkedBox(aabbMin, aabbMax, &p, "setAabb");
@@ -169,13 +170,13 @@ void Broadphase::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbMin, con
   p.m_aabbMax = aabbMax;
 }
 
-void Broadphase::getAabb(btBroadphaseProxy* proxy, btVector3& aabbMin, btVector3& aabbMax) const {
+void BulletDropIn::getAabb(btBroadphaseProxy* proxy, btVector3& aabbMin, btVector3& aabbMax) const {
   const Proxy& p = owned(proxy, "getAabb");
   aabbMin = p.m_aabbMin;
   aabbMax = p.m_aabbMax;
 }
 
-void Broadphase::rayTest(const btVector3& rayFrom, const btVector3& /*rayTo*/, btBroadphaseRayCallback& rayCallback,
+void BulletDropIn::rayTest(const btVector3& rayFrom, const btVector3& /*rayTo*/, btBroadphaseRayCallback& rayCallback,
                          const btVector3& aabbMin, const btVector3& aabbMax) {
   // The callback carries the ray's inverse direction, signs and length, as btDbvtBroadphase uses them.
   const btScalar lambdaMax = rayCallback.m_lambda_max;
@@ -188,15 +189,15 @@ void Broadphase::rayTest(const btVector3& rayFrom, const btVector3& /*rayTo*/, b
   }
 }
 
-void Broadphase::aabbTest(const btVector3& aabbMin, const btVector3& aabbMax, btBroadphaseAabbCallback& callback) {
+void BulletDropIn::aabbTest(const btVector3& aabbMin, const btVector3& aabbMax, btBroadphaseAabbCallback& callback) {
   for (const auto& slot : slots_)
     if (slot->live && TestAabbAgainstAabb2(aabbMin, aabbMax, slot->m_aabbMin, slot->m_aabbMax))
       callback.process(slot.get());
 }
 
-void Broadphase::calculateOverlappingPairs(btDispatcher* dispatcher) {
+void BulletDropIn::calculateOverlappingPairs(btDispatcher* dispatcher) {
   const auto start = Clock::now();
-  report_ = FrameReport{};
+  report_ = BulletDropInReport{};
   report_.proxies = boxes_.size();
   broadPhase_->findPairs(std::span<const Aabb>(boxes_), found_);
   report_.overlaps = found_.size();
@@ -207,84 +208,21 @@ void Broadphase::calculateOverlappingPairs(btDispatcher* dispatcher) {
   // pair order never reaches Bullet, and changes go to the cache in one fixed order.
   foundKeys_.resize(found_.size());
   for (std::size_t k = 0; k < found_.size(); ++k)
-    foundKeys_[k] = pairKey(denseSlot_[found_[k].first], denseSlot_[found_[k].second]);
+    foundKeys_[k] = PairCacheSync::pairKey(denseSlot_[found_[k].first], denseSlot_[found_[k].second]);
   std::sort(foundKeys_.begin(), foundKeys_.end());
-  // present_ is what the cache held after the last frame. Other code may have
-  // changed the cache since (removed a pair, say): then its count differs and
-  // the cache itself is read, so removed pairs come back while they overlap,
-  // as with btSimpleBroadphase.
-  if (static_cast<std::size_t>(cache_->getNumOverlappingPairs()) != present_.size()) rereadCache();
-
-  // A cache with deferred removal (btSortedOverlappingPairCache) ignores
-  // removeOverlappingPair: the broad phase cleans the ended pairs and compacts
-  // the array itself, as btDbvtBroadphase::performDeferredRemoval does.
-  const bool deferred = cache_->hasDeferredRemoval();
-  ended_.clear();
-  next_.clear();
-  std::size_t i = 0, j = 0;
-  while (i < foundKeys_.size() || j < present_.size()) {
-    if (j == present_.size() || (i < foundKeys_.size() && foundKeys_[i] < present_[j])) {
-      // The cache's filter may refuse the pair; it is offered again next frame, as btSimpleBroadphase does.
-      if (cache_->addOverlappingPair(proxyOf(foundKeys_[i] >> 32), proxyOf(foundKeys_[i] & 0xFFFFFFFFu)) != nullptr) {
-        next_.push_back(foundKeys_[i]);
-        ++report_.added;
-      } else {
-        ++report_.refused;
-      }
-      ++i;
-    } else if (i == foundKeys_.size() || present_[j] < foundKeys_[i]) {
-      if (deferred)
-        ended_.push_back(present_[j]);
-      else
-        cache_->removeOverlappingPair(proxyOf(present_[j] >> 32), proxyOf(present_[j] & 0xFFFFFFFFu), dispatcher);
-      ++report_.removed;
-      ++j;
-    } else {
-      next_.push_back(present_[j]);
-      ++i;
-      ++j;
-    }
-  }
-  present_.swap(next_);
-  if (deferred) removeDeferred(dispatcher);
+  const CacheChanges changes = cacheSync_->apply(foundKeys_, dispatcher);
+  report_.added = changes.added;
+  report_.refused = changes.refused;
+  report_.removed = changes.removed;
   report_.cacheSeconds = secondsSince(found);
   report_.totalSeconds = secondsSince(start);
 }
 
-std::uint64_t Broadphase::pairKey(std::uint32_t slotA, std::uint32_t slotB) {
-  return static_cast<std::uint64_t>(std::min(slotA, slotB)) << 32 | std::max(slotA, slotB);
+std::uint64_t BulletDropIn::cachedKey(const btBroadphasePair& pair) const {
+  return PairCacheSync::pairKey(owned(pair.m_pProxy0, "pair cache").slot, owned(pair.m_pProxy1, "pair cache").slot);
 }
 
-std::uint64_t Broadphase::cachedKey(const btBroadphasePair& pair) const {
-  return pairKey(owned(pair.m_pProxy0, "pair cache").slot, owned(pair.m_pProxy1, "pair cache").slot);
-}
-
-btBroadphaseProxy* Broadphase::proxyOf(std::uint64_t slot) const { return slots_[slot].get(); }
-
-void Broadphase::rereadCache() {
-  const btBroadphasePairArray& array = cache_->getOverlappingPairArray();
-  present_.resize(static_cast<std::size_t>(array.size()));
-  for (int k = 0; k < array.size(); ++k) present_[static_cast<std::size_t>(k)] = cachedKey(array[k]);
-  std::sort(present_.begin(), present_.end());
-}
-
-void Broadphase::removeDeferred(btDispatcher* dispatcher) {
-  btBroadphasePairArray& array = cache_->getOverlappingPairArray();
-  int invalid = 0;
-  for (int k = 0; k < array.size(); ++k) {
-    btBroadphasePair& pair = array[k];
-    if (!std::binary_search(ended_.begin(), ended_.end(), cachedKey(pair))) continue;
-    cache_->cleanOverlappingPair(pair, dispatcher);
-    pair.m_pProxy0 = nullptr;
-    pair.m_pProxy1 = nullptr;
-    ++invalid;
-  }
-  // Bullet's pair order puts the emptied pairs last.
-  array.quickSort(btBroadphasePairSortPredicate());
-  array.resize(array.size() - invalid);
-}
-
-void Broadphase::getBroadphaseAabb(btVector3& aabbMin, btVector3& aabbMax) const {
+void BulletDropIn::getBroadphaseAabb(btVector3& aabbMin, btVector3& aabbMax) const {
   aabbMin.setValue(0, 0, 0);
   aabbMax.setValue(0, 0, 0);
   if (boxes_.empty()) return;
@@ -298,16 +236,16 @@ void Broadphase::getBroadphaseAabb(btVector3& aabbMin, btVector3& aabbMax) const
   aabbMax.setValue(all.max[0], all.max[1], all.max[2]);
 }
 
-void Broadphase::resetPool(btDispatcher* /*dispatcher*/) {
+void BulletDropIn::resetPool(btDispatcher* /*dispatcher*/) {
   if (!boxes_.empty()) return;
-  present_.clear();
+  cacheSync_->reset();
   slots_.clear();
   freeSlots_.clear();
 }
 
-void Broadphase::printStats() {
+void BulletDropIn::printStats() {
   const RunStats& s = broadPhase_->stats();
-  fmt::print("bpaccel::Broadphase: backend {} cell size {}, {} proxies, {} cached pairs\n"
+  fmt::print("bpaccel::BulletDropIn: backend {} cell size {}, {} proxies, {} cached pairs\n"
              "  last frame: {} overlaps, {} added, {} refused by the filter, {} removed, find {:.6f} s, cache {:.6f} s\n"
              "  all frames: {} runs, {} device cycles, {} hits\n",
              backendName_, options_.cellSize ? fmt::format("{}", *options_.cellSize) : std::string("none"),

@@ -1,5 +1,5 @@
 #pragma once
-// bpaccel::Broadphase: a btBroadphaseInterface that Bullet worlds take in
+// bpaccel::BulletDropIn: a btBroadphaseInterface that Bullet worlds take in
 // place of btDbvtBroadphase, finding pairs with BroadPhase on any Backend.
 
 #include <cstdint>
@@ -13,6 +13,7 @@
 #include <BulletCollision/BroadphaseCollision/btBroadphaseProxy.h>
 
 #include "../device/backend.hpp"
+#include "pair_cache_sync.hpp"
 #include "../broad_phase/broad_phase.hpp"
 #include "../core/types.hpp"
 
@@ -22,12 +23,12 @@ namespace bpaccel {
 
 /// Misuse of the broad phase (bad AABB, too many proxies, a foreign or
 /// destroyed proxy); the message names the proxy and the reason.
-class BroadphaseError : public std::invalid_argument {
+class BulletDropInError : public std::invalid_argument {
  public:
   using std::invalid_argument::invalid_argument;
 };
 
-struct BroadphaseOptions {
+struct BulletDropInOptions {
   /// k-d tree cell size; none = the whole scene is one cell (chunked to the backend's capacity).
   std::optional<std::size_t> cellSize = 64;
   /// Most live proxies; createProxy beyond it throws. Indices are 32-bit, so never more than 2^32 - 2.
@@ -37,7 +38,7 @@ struct BroadphaseOptions {
 };
 
 /// What the last calculateOverlappingPairs did and spent (steady clock).
-struct FrameReport {
+struct BulletDropInReport {
   std::size_t proxies = 0;
   std::size_t overlaps = 0;         // overlapping proxy pairs found (before the cache's filter)
   std::size_t added = 0;            // pairs that began to overlap and that the cache took
@@ -61,18 +62,18 @@ struct FrameReport {
 ///
 /// Proxies are owned here: their storage lives as long as the broad phase and
 /// is reused (last freed, first reused) by later createProxy calls.
-class Broadphase final : public btBroadphaseInterface {
+class BulletDropIn final : public btBroadphaseInterface {
  public:
   /// `pairCache` null: a btHashedOverlappingPairCache owned here. Otherwise the
   /// caller's cache, which must outlive this broad phase and hold only its proxies.
-  explicit Broadphase(std::unique_ptr<Backend> backend, BroadphaseOptions options = {},
+  explicit BulletDropIn(std::unique_ptr<Backend> backend, BulletDropInOptions options = {},
                       btOverlappingPairCache* pairCache = nullptr);
   /// `options.threads` workers, each with a backend of its own from `makeBackend`.
-  explicit Broadphase(const BroadPhase::BackendFactory& makeBackend, BroadphaseOptions options = {},
+  explicit BulletDropIn(const BackendFactory& makeBackend, BulletDropInOptions options = {},
                       btOverlappingPairCache* pairCache = nullptr);
-  ~Broadphase() override;
-  Broadphase(const Broadphase&) = delete;
-  Broadphase& operator=(const Broadphase&) = delete;
+  ~BulletDropIn() override;
+  BulletDropIn(const BulletDropIn&) = delete;
+  BulletDropIn& operator=(const BulletDropIn&) = delete;
 
   btBroadphaseProxy* createProxy(const btVector3& aabbMin, const btVector3& aabbMax, int shapeType, void* userPtr,
                                  int collisionFilterGroup, int collisionFilterMask, btDispatcher* dispatcher) override;
@@ -97,7 +98,7 @@ class Broadphase final : public btBroadphaseInterface {
   void printStats() override;
 
   std::size_t proxyCount() const { return boxes_.size(); }
-  const FrameReport& lastFrame() const { return report_; }
+  const BulletDropInReport& lastFrame() const { return report_; }
   /// The backend's name (cpu, model, rtl).
   const std::string& backendName() const { return backendName_; }
   /// Statistics of the pair finding, summed over all frames.
@@ -106,17 +107,13 @@ class Broadphase final : public btBroadphaseInterface {
  private:
   struct Proxy;
   Proxy& owned(btBroadphaseProxy* proxy, const char* what) const;
-  static std::uint64_t pairKey(std::uint32_t slotA, std::uint32_t slotB);
   std::uint64_t cachedKey(const btBroadphasePair& pair) const;
-  btBroadphaseProxy* proxyOf(std::uint64_t slot) const;
-  void rereadCache();
-  void removeDeferred(btDispatcher* dispatcher);
   static Aabb checkedBox(const btVector3& aabbMin, const btVector3& aabbMax, const Proxy* proxy, const char* what);
 
-  Broadphase(std::unique_ptr<Backend> backend, const BroadPhase::BackendFactory* makeBackend,
-             BroadphaseOptions options, btOverlappingPairCache* pairCache);
+  BulletDropIn(std::unique_ptr<Backend> backend, const BackendFactory* makeBackend,
+             BulletDropInOptions options, btOverlappingPairCache* pairCache);
 
-  BroadphaseOptions options_;
+  BulletDropInOptions options_;
   std::string backendName_;
   std::unique_ptr<Backend> backend_;         // the one backend, unless a factory makes them
   std::unique_ptr<BroadPhase> broadPhase_;
@@ -128,11 +125,9 @@ class Broadphase final : public btBroadphaseInterface {
   std::vector<std::uint32_t> denseSlot_;        // slot of each dense box
   // Pairs of slots as keys (lower << 32 | higher), sorted.
   std::vector<Pair> found_;                     // this frame's pairs, dense indices
-  std::vector<std::uint64_t> foundKeys_;        // the same as slot keys
-  std::vector<std::uint64_t> present_;          // the cache's pairs after the last frame
-  std::vector<std::uint64_t> next_;             // present_ being rebuilt
-  std::vector<std::uint64_t> ended_;            // pairs to drop from a cache with deferred removal
-  FrameReport report_;
+  std::vector<std::uint64_t> foundKeys_;        // the same as slot keys (PairCacheSync::pairKey), sorted
+  std::unique_ptr<PairCacheSync> cacheSync_;    // the cache brought to each frame's pairs
+  BulletDropInReport report_;
 };
 
 }  // namespace bpaccel

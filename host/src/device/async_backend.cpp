@@ -7,25 +7,25 @@
 namespace bpaccel {
 
 // The stage's bound is not the host's: a caller may submit as many hand-overs as it likes.
-AsyncBackend::AsyncBackend(const DeviceFactory& makeDevice, std::chrono::microseconds spinBeforeSleep)
+AsyncBackend::AsyncBackend(const BackendFactory& makeBackend, std::chrono::microseconds spinBeforeSleep)
     : stage_(std::numeric_limits<std::size_t>::max(), spinBeforeSleep) {
-  stage_.post([this, &makeDevice] {
-    device_ = makeDevice();
-    if (!device_) throw std::invalid_argument("async backend: the device factory gave no device");
-    name_ = device_->name();
-    capacity_ = device_->capacity();
-    bipartite_ = device_->bipartite();
-    keyWidth_ = device_->keyWidth();
+  stage_.post([this, &makeBackend] {
+    backend_ = makeBackend();
+    if (!backend_) throw std::invalid_argument("async backend: the backend factory gave no backend");
+    name_ = backend_->name();
+    capacity_ = backend_->capacity();
+    bipartite_ = backend_->bipartite();
+    keyWidth_ = backend_->keyWidth();
   });
-  stage_.drain();  // the device exists (or its failure is rethrown here, while `makeDevice` still does)
+  stage_.drain();  // the backend exists (or its failure is rethrown here, while `makeBackend` still does)
 }
 
-// The device goes on the thread that built it, after every hand-over submitted before.
+// The backend goes on the thread that built it, after every hand-over submitted before.
 AsyncBackend::~AsyncBackend() {
-  stage_.post([this] { device_.reset(); });
+  stage_.post([this] { backend_.reset(); });
   try {
     stage_.drain();
-  } catch (...) {  // a failure the destructor cannot report; the device is gone all the same
+  } catch (...) {  // a failure the destructor cannot report; the backend is gone all the same
   }
 }
 
@@ -34,7 +34,7 @@ std::future<BatchResult> AsyncBackend::submit(std::span<const std::span<const Ke
   auto job = std::make_shared<std::packaged_task<BatchResult()>>(
       [this, cells = std::vector(cells.begin(), cells.end()), splits = std::vector(splits.begin(), splits.end())] {
         BatchResult out;
-        device_->runBatch(cells, splits, out.pairs, out.cellEnds, out.stats);
+        backend_->runBatch(cells, splits, out.pairs, out.cellEnds, out.stats);
         return out;
       });
   auto result = job->get_future();

@@ -23,17 +23,18 @@ struct BatchResult {
   RunStats stats;
 };
 
-/// A device on a thread of its own that runs hand-overs one after the other
-/// in the order they were submitted, as a card with a command queue would.
+/// A backend on a thread of its own (the device's thread) that runs
+/// hand-overs one after the other in the order they were submitted, as a
+/// card with a command queue would.
 /// submit() returns at once with a future to poll (wait_for with a zero
-/// timeout) or to wait on; an exception of the device (a hang, a hardware
+/// timeout) or to wait on; an exception of the backend (a hang, a hardware
 /// error, a cell over its capacity) comes out of that future's get(). The
 /// cells' boxes must stay valid until their future is ready.
 ///
-/// The device is built, run and destroyed on that thread, from `makeDevice`:
+/// The backend is built, run and destroyed on that thread, from `makeBackend`:
 /// a Verilated model must be evaluated by the thread that constructed it
 /// (Verilator's rule; RtlBackend deadlocked at destruction otherwise). The
-/// constructor returns once the device exists, and rethrows its failure.
+/// constructor returns once the backend exists, and rethrows its failure.
 /// Destruction finishes every hand-over submitted before it.
 ///
 /// `spinBeforeSleep`: the device's thread polls for the next hand-over that
@@ -41,8 +42,7 @@ struct BatchResult {
 /// wake-up; wake() starts it polling ahead of a frame's first hand-over.
 class AsyncBackend {
  public:
-  using DeviceFactory = std::function<std::unique_ptr<Backend>()>;
-  explicit AsyncBackend(const DeviceFactory& makeDevice, std::chrono::microseconds spinBeforeSleep = {});
+  explicit AsyncBackend(const BackendFactory& makeBackend, std::chrono::microseconds spinBeforeSleep = {});
   ~AsyncBackend();
   AsyncBackend(const AsyncBackend&) = delete;
   AsyncBackend& operator=(const AsyncBackend&) = delete;
@@ -63,7 +63,7 @@ class AsyncBackend {
   void awaken();
 
  private:
-  std::unique_ptr<Backend> device_;  // built, used and destroyed on the stage's thread only
+  std::unique_ptr<Backend> backend_;  // built, used and destroyed on the stage's thread only
   std::string name_;
   std::size_t capacity_ = 0;
   bool bipartite_ = false;

@@ -3,6 +3,7 @@
 // of at most capacity() boxes each.
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <span>
 #include <string>
@@ -11,6 +12,10 @@
 #include "../core/types.hpp"
 
 namespace bpaccel {
+
+class Backend;
+/// Makes a backend: for a thread, or a device thread, of its own.
+using BackendFactory = std::function<std::unique_ptr<Backend>()>;
 
 /// Loads up to capacity() boxes, runs, and returns every overlapping pair
 /// (indices into the batch, i < j) with the run's statistics.

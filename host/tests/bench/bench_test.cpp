@@ -15,7 +15,7 @@
 #include "device/backend.hpp"
 #include "benchmark.hpp"
 #include "bpaccel_params.h"
-#include "peers/bullet_broadphases.hpp"
+#include "peers/bullet_methods.hpp"
 #include "exact_pairs.hpp"
 #include "peers/ode_spaces.hpp"
 #include "device/rtl/rtl_backend.hpp"

@@ -1,4 +1,4 @@
-// bpaccel::Broadphase in Bullet worlds: the contacts Bullet's own broad
+// bpaccel::BulletDropIn in Bullet worlds: the contacts Bullet's own broad
 // phases give, the exact pair set in the cache, filters, proxy life and
 // misuse.
 
@@ -28,8 +28,8 @@
 
 namespace {
 
-using bpaccel::Broadphase;
-using bpaccel::BroadphaseError;
+using bpaccel::BulletDropIn;
+using bpaccel::BulletDropInError;
 using bpaccel::Pair;
 
 std::unique_ptr<bpaccel::Backend> makeBackend(const std::string& name) {
@@ -56,7 +56,7 @@ class DroppingBackend final : public bpaccel::Backend {
   bpaccel::CpuBackend inner_;
 };
 
-using Factory = bpaccel::BroadphaseFactory;
+using Factory = bpaccel::BtBroadphaseFactory;
 Factory dbvt() {
   return [] { return std::make_unique<btDbvtBroadphase>(); };
 }
@@ -64,16 +64,16 @@ Factory simple() {
   return [] { return std::make_unique<btSimpleBroadphase>(4096); };
 }
 Factory accel(const std::string& backend, std::optional<std::size_t> cellSize) {
-  return [=] { return std::make_unique<Broadphase>(makeBackend(backend), bpaccel::BroadphaseOptions{cellSize}); };
+  return [=] { return std::make_unique<BulletDropIn>(makeBackend(backend), bpaccel::BulletDropInOptions{cellSize}); };
 }
 Factory accelThreads(const std::string& backend, std::size_t cellSize, std::size_t threads) {
   return [=] {
-    return std::make_unique<Broadphase>([=] { return makeBackend(backend); },
-                                        bpaccel::BroadphaseOptions{cellSize, 0xFFFFFFFEull, threads});
+    return std::make_unique<BulletDropIn>([=] { return makeBackend(backend); },
+                                        bpaccel::BulletDropInOptions{cellSize, 0xFFFFFFFEull, threads});
   };
 }
 Factory dropping() {
-  return [] { return std::make_unique<Broadphase>(std::make_unique<DroppingBackend>(), bpaccel::BroadphaseOptions{}); };
+  return [] { return std::make_unique<BulletDropIn>(std::make_unique<DroppingBackend>(), bpaccel::BulletDropInOptions{}); };
 }
 
 /// A Bullet world a test can step and change; bodies carry a stable id in their user index.
@@ -328,7 +328,7 @@ TEST(DropIn, ComparisonWithDbvtTrajectoriesIsOnlyAboutContacts) {
 // After every step, the cache holds exactly the filtered overlaps of the proxies' AABBs.
 TEST(DropIn, PairCacheHoldsExactlyTheOverlapsEveryFrame) {
   BouncingWorld w(200, accel("cpu", 32)());
-  auto* bp = static_cast<Broadphase*>(w.world().getBroadphase());
+  auto* bp = static_cast<BulletDropIn*>(w.world().getBroadphase());
   btOverlappingPairCache* cache = bp->getOverlappingPairCache();
   auto& objs = w.world().getCollisionObjectArray();
   std::size_t seen = 0;
@@ -362,7 +362,7 @@ struct Fixture {
   btCollisionDispatcher dispatcher{&config};
 };
 
-btBroadphaseProxy* box(Broadphase& bp, Fixture& fx, float lo, float hi, void* user = nullptr, int group = 1,
+btBroadphaseProxy* box(BulletDropIn& bp, Fixture& fx, float lo, float hi, void* user = nullptr, int group = 1,
                        int mask = -1) {
   return bp.createProxy(btVector3(lo, lo, lo), btVector3(hi, hi, hi), BOX_SHAPE_PROXYTYPE, user, group, mask,
                         &fx.dispatcher);
@@ -370,7 +370,7 @@ btBroadphaseProxy* box(Broadphase& bp, Fixture& fx, float lo, float hi, void* us
 
 TEST(DropIn, PairsBeginAndEndIncrementallyAndLeaveWithTheirProxy) {
   Fixture fx;
-  Broadphase bp(makeBackend("cpu"));
+  BulletDropIn bp(makeBackend("cpu"));
   auto* a = box(bp, fx, 0, 1);
   auto* b = box(bp, fx, 1, 2);  // touches a at one corner: overlaps
   auto* c = box(bp, fx, 5, 6);
@@ -407,7 +407,7 @@ TEST(DropIn, PairsBeginAndEndIncrementallyAndLeaveWithTheirProxy) {
 
 TEST(DropIn, CollisionFilterGroupsMasksAndCallbackDecide) {
   Fixture fx;
-  Broadphase bp(makeBackend("model"), {std::nullopt});
+  BulletDropIn bp(makeBackend("model"), {std::nullopt});
   int tagA, tagB, tagC, tagD;
   auto* a = box(bp, fx, 0, 2, &tagA, 1, 2);
   auto* b = box(bp, fx, 0, 2, &tagB, 2, 1);   // a and b accept each other
@@ -455,7 +455,7 @@ TEST(DropIn, UsesTheCacheItIsGiven) {
   btHashedOverlappingPairCache hashed;
   btSortedOverlappingPairCache sorted;
   for (btOverlappingPairCache* cache : std::initializer_list<btOverlappingPairCache*>{&hashed, &sorted}) {
-    Broadphase bp(makeBackend("cpu"), {}, cache);
+    BulletDropIn bp(makeBackend("cpu"), {}, cache);
     EXPECT_EQ(bp.getOverlappingPairCache(), cache);
     auto* a = box(bp, fx, 0, 1);
     auto* b = box(bp, fx, 0.5f, 2);
@@ -475,12 +475,12 @@ TEST(DropIn, UsesTheCacheItIsGiven) {
 
 TEST(DropIn, RejectsNanAndInvertedBoxesNamingTheProxy) {
   Fixture fx;
-  Broadphase bp(makeBackend("cpu"));
+  BulletDropIn bp(makeBackend("cpu"));
   const float nan = std::numeric_limits<float>::quiet_NaN();
   try {
     bp.createProxy(btVector3(0, nan, 0), btVector3(1, 1, 1), BOX_SHAPE_PROXYTYPE, nullptr, 1, -1, &fx.dispatcher);
     FAIL() << "NaN accepted";
-  } catch (const BroadphaseError& e) {
+  } catch (const BulletDropInError& e) {
     EXPECT_NE(std::string(e.what()).find("NaN"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find(" y "), std::string::npos) << e.what();
   }
@@ -489,7 +489,7 @@ TEST(DropIn, RejectsNanAndInvertedBoxesNamingTheProxy) {
   try {
     bp.setAabb(a, btVector3(0, 2, 0), btVector3(1, 1, 1), &fx.dispatcher);
     FAIL() << "min > max accepted";
-  } catch (const BroadphaseError& e) {
+  } catch (const BulletDropInError& e) {
     EXPECT_NE(std::string(e.what()).find("proxy 2"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("min 2 > max 1 on y"), std::string::npos) << e.what();
   }
@@ -503,51 +503,51 @@ TEST(DropIn, RejectsNanAndInvertedBoxesNamingTheProxy) {
 
 TEST(DropIn, RefusesMoreProxiesThanAllowed) {
   Fixture fx;
-  Broadphase bp(makeBackend("cpu"), {64, 2});
+  BulletDropIn bp(makeBackend("cpu"), {64, 2});
   auto* a = box(bp, fx, 0, 1);
   box(bp, fx, 0, 1);
   EXPECT_THROW(
       {
         try {
           box(bp, fx, 0, 1);
-        } catch (const BroadphaseError& e) {
+        } catch (const BulletDropInError& e) {
           EXPECT_NE(std::string(e.what()).find("at most 2 proxies"), std::string::npos) << e.what();
           throw;
         }
       },
-      BroadphaseError);
+      BulletDropInError);
   bp.destroyProxy(a, &fx.dispatcher);
   EXPECT_NO_THROW(box(bp, fx, 0, 1));
-  EXPECT_THROW(Broadphase(makeBackend("cpu"), {64, 0}), BroadphaseError);
+  EXPECT_THROW(BulletDropIn(makeBackend("cpu"), {64, 0}), BulletDropInError);
   // Threads need a backend each.
-  EXPECT_THROW(Broadphase(makeBackend("cpu"), {64, 100, 2}), BroadphaseError);
-  EXPECT_THROW(Broadphase(makeBackend("cpu"), {64, 100, 0}), BroadphaseError);
-  EXPECT_THROW(Broadphase([] { return std::unique_ptr<bpaccel::Backend>(); }, {64, 100, 2}), BroadphaseError);
-  EXPECT_EQ(Broadphase([] { return makeBackend("model"); }, {64, 100, 2}).backendName(), "model");
+  EXPECT_THROW(BulletDropIn(makeBackend("cpu"), {64, 100, 2}), BulletDropInError);
+  EXPECT_THROW(BulletDropIn(makeBackend("cpu"), {64, 100, 0}), BulletDropInError);
+  EXPECT_THROW(BulletDropIn([] { return std::unique_ptr<bpaccel::Backend>(); }, {64, 100, 2}), BulletDropInError);
+  EXPECT_EQ(BulletDropIn([] { return makeBackend("model"); }, {64, 100, 2}).backendName(), "model");
 }
 
 TEST(DropIn, RejectsForeignAndDestroyedProxies) {
   Fixture fx;
-  Broadphase bp(makeBackend("cpu"));
+  BulletDropIn bp(makeBackend("cpu"));
   btDbvtBroadphase other;
   auto* foreign = other.createProxy(btVector3(0, 0, 0), btVector3(1, 1, 1), BOX_SHAPE_PROXYTYPE, nullptr, 1, -1,
                                     &fx.dispatcher);
-  EXPECT_THROW(bp.setAabb(foreign, btVector3(0, 0, 0), btVector3(1, 1, 1), &fx.dispatcher), BroadphaseError);
-  EXPECT_THROW(bp.destroyProxy(nullptr, &fx.dispatcher), BroadphaseError);
+  EXPECT_THROW(bp.setAabb(foreign, btVector3(0, 0, 0), btVector3(1, 1, 1), &fx.dispatcher), BulletDropInError);
+  EXPECT_THROW(bp.destroyProxy(nullptr, &fx.dispatcher), BulletDropInError);
   other.destroyProxy(foreign, &fx.dispatcher);
   auto* a = box(bp, fx, 0, 1);
   bp.destroyProxy(a, &fx.dispatcher);
   try {
     bp.destroyProxy(a, &fx.dispatcher);
     FAIL() << "double destroy accepted";
-  } catch (const BroadphaseError& e) {
+  } catch (const BulletDropInError& e) {
     EXPECT_NE(std::string(e.what()).find("already destroyed"), std::string::npos) << e.what();
   }
 }
 
 TEST(DropIn, BoundsAndPoolReset) {
   Fixture fx;
-  Broadphase bp(makeBackend("cpu"));
+  BulletDropIn bp(makeBackend("cpu"));
   btVector3 lo, hi;
   bp.getBroadphaseAabb(lo, hi);
   EXPECT_EQ(lo, btVector3(0, 0, 0));
@@ -625,7 +625,7 @@ TEST(DropIn, RayAndBoxQueriesAgreeWithDbvt) {
 
 TEST(DropIn, PrintStatsNamesBackendProxiesAndPairs) {
   Fixture fx;
-  Broadphase bp(makeBackend("model"), {16});
+  BulletDropIn bp(makeBackend("model"), {16});
   box(bp, fx, 0, 1);
   box(bp, fx, 0.5f, 2);
   box(bp, fx, 5, 6);

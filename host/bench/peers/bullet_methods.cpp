@@ -1,4 +1,4 @@
-#include "bullet_broadphases.hpp"
+#include "bullet_methods.hpp"
 #include "bullet_pairs.hpp"
 
 #include <algorithm>
@@ -28,7 +28,7 @@ btVector3 hi(const Aabb& b) { return {b.max[0], b.max[1], b.max[2]}; }
 
 }  // namespace
 
-std::string BulletBroadphase::name(Kind kind) {
+std::string BulletMethod::name(Kind kind) {
   switch (kind) {
     case Kind::Dbvt: return "btDbvtBroadphase";
     case Kind::AxisSweep32: return "bt32BitAxisSweep3";
@@ -37,7 +37,7 @@ std::string BulletBroadphase::name(Kind kind) {
   return "?";
 }
 
-BulletBroadphase::BulletBroadphase(Kind kind, std::span<const Aabb> initial, float worldMin, float worldMax)
+BulletMethod::BulletMethod(Kind kind, std::span<const Aabb> initial, float worldMin, float worldMax)
     : kind_(kind),
       config_(std::make_unique<btDefaultCollisionConfiguration>()),
       dispatcher_(std::make_unique<btCollisionDispatcher>(config_.get())) {
@@ -77,20 +77,20 @@ BulletBroadphase::BulletBroadphase(Kind kind, std::span<const Aabb> initial, flo
 // arrays they free themselves; destroying them one by one would cost the
 // sweep O(n^2) (each removal moves its edges to the end of every axis). No
 // pair holds a collision algorithm: nothing was dispatched.
-BulletBroadphase::~BulletBroadphase() {
+BulletMethod::~BulletMethod() {
   if (kind_ != Kind::Dbvt) return;
   removeAllOverlappingPairs(*broadphase_->getOverlappingPairCache(), dispatcher_.get());
   for (btBroadphaseProxy* p : proxies_) broadphase_->destroyProxy(p, dispatcher_.get());
 }
 
-void BulletBroadphase::update(std::span<const Aabb> boxes) {
+void BulletMethod::update(std::span<const Aabb> boxes) {
   if (boxes.size() != proxies_.size()) throw std::invalid_argument("bullet broadphase: object count changed");
   for (std::size_t i = 0; i < boxes.size(); ++i)
     broadphase_->setAabb(proxies_[i], lo(boxes[i]), hi(boxes[i]), dispatcher_.get());
   broadphase_->calculateOverlappingPairs(dispatcher_.get());
 }
 
-void BulletBroadphase::pairs(std::vector<Pair>& out) {
+void BulletMethod::pairs(std::vector<Pair>& out) {
   out.clear();
   const btBroadphasePairArray& array = broadphase_->getOverlappingPairCache()->getOverlappingPairArray();
   out.reserve(static_cast<std::size_t>(array.size()));
@@ -113,16 +113,16 @@ std::optional<std::string> axisSweepSkipReason(std::size_t objects) {
 
 std::vector<MethodSpec> bulletMethods(double maxAllPairsTests) {
   std::vector<MethodSpec> specs;
-  for (auto kind : {BulletBroadphase::Kind::Dbvt, BulletBroadphase::Kind::AxisSweep32, BulletBroadphase::Kind::Simple}) {
+  for (auto kind : {BulletMethod::Kind::Dbvt, BulletMethod::Kind::AxisSweep32, BulletMethod::Kind::Simple}) {
     MethodSpec s;
-    s.name = BulletBroadphase::name(kind);
+    s.name = BulletMethod::name(kind);
     s.kind = MethodKind::Bullet;
     s.library = kBullet;
-    if (kind == BulletBroadphase::Kind::AxisSweep32)
+    if (kind == BulletMethod::Kind::AxisSweep32)
       s.skipReason = [](const SceneStart& start) { return axisSweepSkipReason(start.boxes.size()); };
-    if (kind == BulletBroadphase::Kind::Simple) s.skipReason = allPairsSkipReason(maxAllPairsTests);
+    if (kind == BulletMethod::Kind::Simple) s.skipReason = allPairsSkipReason(maxAllPairsTests);
     s.make = [kind](const SceneStart& start) {
-      return std::make_unique<BulletBroadphase>(kind, start.boxes, start.worldMin, start.worldMax);
+      return std::make_unique<BulletMethod>(kind, start.boxes, start.worldMin, start.worldMax);
     };
     specs.push_back(std::move(s));
   }

@@ -16,16 +16,16 @@ class btDefaultCollisionConfiguration;
 
 namespace bpaccel {
 
-class BulletBroadphase final : public TimedMethod {
+class BulletMethod final : public TimedMethod {
  public:
   enum class Kind { Dbvt, AxisSweep32, Simple };
   static std::string name(Kind kind);
 
   /// Creates one proxy per box. `worldMin`/`worldMax` bound the sweep-and-prune's quantisation.
-  BulletBroadphase(Kind kind, std::span<const Aabb> initial, float worldMin, float worldMax);
-  ~BulletBroadphase() override;
-  BulletBroadphase(const BulletBroadphase&) = delete;
-  BulletBroadphase& operator=(const BulletBroadphase&) = delete;
+  BulletMethod(Kind kind, std::span<const Aabb> initial, float worldMin, float worldMax);
+  ~BulletMethod() override;
+  BulletMethod(const BulletMethod&) = delete;
+  BulletMethod& operator=(const BulletMethod&) = delete;
 
   /// setAabb for every object and calculateOverlappingPairs: the work timed per frame.
   void update(std::span<const Aabb> boxes) override;

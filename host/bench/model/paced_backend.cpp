@@ -1,4 +1,4 @@
-#include "paced_device.hpp"
+#include "paced_backend.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -17,20 +17,20 @@ void append(const BatchResult& answer, std::vector<Pair>& out, std::vector<std::
   stats += answer.stats;
 }
 
-double seconds(PacedDevice::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+double seconds(PacedBackend::Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
 }  // namespace
 
-RecordingDevice::RecordingDevice(std::unique_ptr<Backend> inner, AnswerRecording& recording)
+RecordingBackend::RecordingBackend(std::unique_ptr<Backend> inner, AnswerRecording& recording)
     : inner_(std::move(inner)), recording_(recording) {
   if (!inner_) throw std::invalid_argument("recording device: no backend to record");
 }
 
-void RecordingDevice::run(std::span<const KeyBox>, std::vector<Pair>&, RunStats&) {
+void RecordingBackend::run(std::span<const KeyBox>, std::vector<Pair>&, RunStats&) {
   throw std::logic_error("recording device: batches only (cells per batch of at least 2)");
 }
 
-void RecordingDevice::runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
+void RecordingBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
                                std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) {
   BatchResult r;  // this hand-over's own: its cell ends count from 0
   inner_->runBatch(cells, splits, r.pairs, r.cellEnds, r.stats);
@@ -38,23 +38,23 @@ void RecordingDevice::runBatch(std::span<const std::span<const KeyBox>> cells, s
   recording_.push_back(std::move(r));
 }
 
-PacedDevice::PacedDevice(const AnswerRecording& recording, const Backend& recorded, const PipelineModel& model)
+PacedBackend::PacedBackend(const AnswerRecording& recording, const Backend& recorded, const PipelineModel& model)
     : recording_(recording), recorded_(recorded), model_(model) {
   if (!(model.clockHz > 0) || !(model.bandwidthBytesPerSecond > 0) || model.latencySeconds < 0)
     throw std::invalid_argument("paced device: clock and bandwidth must be positive, latency not negative");
   prctl(PR_SET_TIMERSLACK, 1UL);  // this thread's sleeps end on time, not up to 50 us late
 }
 
-void PacedDevice::run(std::span<const KeyBox>, std::vector<Pair>&, RunStats&) {
+void PacedBackend::run(std::span<const KeyBox>, std::vector<Pair>&, RunStats&) {
   throw std::logic_error("paced device: batches only (cells per batch of at least 2)");
 }
 
-void PacedDevice::rewind(Clock::time_point frameStart) {
+void PacedBackend::rewind(Clock::time_point frameStart) {
   next_ = 0;
   frameStart_ = frameStart;
 }
 
-void PacedDevice::runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t>,
+void PacedBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t>,
                            std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) {
   const auto reached = Clock::now();
   if (next_ >= recording_.size() || recording_[next_].cellEnds.size() != cells.size())
@@ -80,7 +80,7 @@ PacedBroadPhase::PacedBroadPhase(const AnswerRecording& recording, const Backend
   // Built on the device's thread while the constructor waits: the pointer is set when it returns.
   phase_ = std::make_unique<BroadPhase>(
       [&] {
-        auto device = std::make_unique<PacedDevice>(recording, recorded, model);
+        auto device = std::make_unique<PacedBackend>(recording, recorded, model);
         device_ = device.get();
         return device;
       },
@@ -88,7 +88,7 @@ PacedBroadPhase::PacedBroadPhase(const AnswerRecording& recording, const Backend
 }
 
 void PacedBroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) {
-  device_->rewind(PacedDevice::Clock::now());
+  device_->rewind(PacedBackend::Clock::now());
   phase_->findPairs(boxes, out);
 }
 

@@ -23,9 +23,9 @@ using AnswerRecording = std::vector<BatchResult>;
 /// A backend whose answers are recorded: the inner backend (rtl, model)
 /// answers, and each hand-over's own answer is appended to `recording`
 /// (which the caller clears between frames). Batches only.
-class RecordingDevice final : public Backend {
+class RecordingBackend final : public Backend {
  public:
-  RecordingDevice(std::unique_ptr<Backend> inner, AnswerRecording& recording);
+  RecordingBackend(std::unique_ptr<Backend> inner, AnswerRecording& recording);
   std::string name() const override { return inner_->name(); }
   std::size_t capacity() const override { return inner_->capacity(); }
   unsigned keyWidth() const override { return inner_->keyWidth(); }
@@ -50,12 +50,12 @@ class RecordingDevice final : public Backend {
 /// hand-over more than the model. Run it on a thread of its own
 /// (BroadPhase with HandOvers::Asynchronous or Polled); each frame, rewind()
 /// it before the broad phase runs the frame whose answers are recorded.
-class PacedDevice final : public Backend {
+class PacedBackend final : public Backend {
  public:
   using Clock = std::chrono::steady_clock;
   /// `recorded`: the device whose answers `recording` holds (its capacity,
   /// key width and runs are this one's). `model`: the clock and link.
-  PacedDevice(const AnswerRecording& recording, const Backend& recorded, const PipelineModel& model);
+  PacedBackend(const AnswerRecording& recording, const Backend& recorded, const PipelineModel& model);
   std::string name() const override { return "paced replay of " + recorded_.name(); }
   std::size_t capacity() const override { return recorded_.capacity(); }
   unsigned keyWidth() const override { return recorded_.keyWidth(); }
@@ -88,7 +88,7 @@ class PacedDevice final : public Backend {
 };
 
 /// A broad phase whose batches go, with the asynchronous hand-overs of
-/// `config` (Asynchronous or Polled), to a PacedDevice that replays
+/// `config` (Asynchronous or Polled), to a PacedBackend that replays
 /// `recording`: each frame it runs the boxes of the frame whose answers were
 /// last recorded, on the host's threads as they would drive a real device,
 /// with the device's durations emulated. `recorded` is the device that
@@ -103,10 +103,10 @@ class PacedBroadPhase {
   /// The recorded frame again: the device replays the recording from its start.
   void findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out);
   const BroadPhase& phase() const { return *phase_; }
-  const PacedDevice& device() const { return *device_; }
+  const PacedBackend& device() const { return *device_; }
 
  private:
-  PacedDevice* device_ = nullptr;  // owned by phase_'s device thread
+  PacedBackend* device_ = nullptr;  // owned by phase_'s device thread
   std::unique_ptr<BroadPhase> phase_;
 };
 

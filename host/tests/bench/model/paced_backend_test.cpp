@@ -8,7 +8,7 @@
 #include "device/model_backend.hpp"
 #include "device/backend.hpp"
 #include "broad_phase/broad_phase.hpp"
-#include "model/paced_device.hpp"
+#include "model/paced_backend.hpp"
 #include "scenes.hpp"
 
 using namespace bpaccel;
@@ -37,9 +37,9 @@ std::vector<std::span<const KeyBox>> spansOf(const std::vector<std::vector<KeyBo
 
 }  // namespace
 
-TEST(RecordingDevice, GivesTheInnerBackendsAnswerAndRecordsEachHandOversOwn) {
+TEST(RecordingBackend, GivesTheInnerBackendsAnswerAndRecordsEachHandOversOwn) {
   AnswerRecording recording;
-  RecordingDevice recorder(std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)), recording);
+  RecordingBackend recorder(std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)), recording);
   ModelBackend plain(DeviceParams::seed(2, 64, 5));
   const auto cells = someCells();
   std::vector<Pair> got, expected;
@@ -59,13 +59,13 @@ TEST(RecordingDevice, GivesTheInnerBackendsAnswerAndRecordsEachHandOversOwn) {
   std::vector<Pair> single;
   RunStats s;
   EXPECT_THROW(recorder.run(cells[0], single, s), std::logic_error);
-  EXPECT_THROW(RecordingDevice(nullptr, recording), std::invalid_argument);
+  EXPECT_THROW(RecordingBackend(nullptr, recording), std::invalid_argument);
 }
 
-TEST(PacedDevice, AnswersWithTheRecordingNoSoonerThanItsModelledTime) {
+TEST(PacedBackend, AnswersWithTheRecordingNoSoonerThanItsModelledTime) {
   AnswerRecording recording;
   ModelBackend model(DeviceParams::seed(2, 64, 5));
-  RecordingDevice recorder(std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)), recording);
+  RecordingBackend recorder(std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)), recording);
   const auto cells = someCells();
   std::vector<Pair> recorded;
   std::vector<std::size_t> recordedEnds;
@@ -75,7 +75,7 @@ TEST(PacedDevice, AnswersWithTheRecordingNoSoonerThanItsModelledTime) {
   PipelineModel slow;  // a slow clock: the hold is long enough to tell from no hold at all
   slow.clockHz = 1e4;
   slow.latencySeconds = 1e-4;
-  PacedDevice paced(recording, model, slow);
+  PacedBackend paced(recording, model, slow);
   EXPECT_EQ(paced.capacity(), model.capacity());
   EXPECT_EQ(paced.bipartite(), model.bipartite());
   const auto t = handOverTimes(recordedStats, slow);
@@ -84,10 +84,10 @@ TEST(PacedDevice, AnswersWithTheRecordingNoSoonerThanItsModelledTime) {
   std::vector<Pair> got;
   std::vector<std::size_t> ends;
   RunStats stats;
-  const auto start = PacedDevice::Clock::now();
+  const auto start = PacedBackend::Clock::now();
   paced.rewind(start);
   paced.runBatch(spansOf(cells), {}, got, ends, stats);
-  EXPECT_GE(std::chrono::duration<double>(PacedDevice::Clock::now() - start).count(), hold);
+  EXPECT_GE(std::chrono::duration<double>(PacedBackend::Clock::now() - start).count(), hold);
   EXPECT_EQ(got, recorded);
   EXPECT_EQ(ends, recordedEnds);
   EXPECT_EQ(stats.deviceCycles(), recordedStats.deviceCycles());
@@ -99,17 +99,17 @@ TEST(PacedDevice, AnswersWithTheRecordingNoSoonerThanItsModelledTime) {
 
   // One hand-over more than recorded, or another cell count, is not the recorded frame.
   EXPECT_THROW(paced.runBatch(spansOf(cells), {}, got, ends, stats), std::logic_error);
-  paced.rewind(PacedDevice::Clock::now());
+  paced.rewind(PacedBackend::Clock::now());
   const auto fewer = std::vector<std::vector<KeyBox>>(cells.begin(), cells.begin() + 2);
   EXPECT_THROW(paced.runBatch(spansOf(fewer), {}, got, ends, stats), std::logic_error);
   slow.clockHz = 0;
-  EXPECT_THROW(PacedDevice(recording, model, slow), std::invalid_argument);
+  EXPECT_THROW(PacedBackend(recording, model, slow), std::invalid_argument);
 }
 
 TEST(PacedBroadPhase, PolledHandOversAgainstThePacedDeviceGiveTheRecordedFramesPairs) {
   for (const auto& [name, boxes] : adversarialScenes(600, 31)) {
     AnswerRecording recording;
-    RecordingDevice recorder(std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)), recording);
+    RecordingBackend recorder(std::make_unique<ModelBackend>(DeviceParams::seed(2, 64, 5)), recording);
     BroadPhaseConfig config{
         .cellSize = 16, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 8, .firstBatchCells = 2};
     BroadPhase sync(recorder, config);
