@@ -119,12 +119,12 @@ nlohmann::json describe(const LineUpConfig& config) {
     j["clock_hz"] = d->clockHz;
     j["clock_source"] = d->clockSource;
     j["link_model"] = {{"bandwidth_bytes_per_second", d->link.bandwidthBytesPerSecond},
-                       {"latency_seconds_per_run", d->link.latencySecondsPerRun},
+                       {"latency_seconds_per_run", d->link.latencySeconds},
                        {"cells_per_batch", d->cellsPerBatch},
                        {"first_batch_cells", d->firstBatchCells ? std::min(d->firstBatchCells, d->cellsPerBatch)
                                                                 : d->cellsPerBatch},
                        {"bytes_per_box", d->link.bytesPerBox},
-                       {"bytes_per_result_beat", d->beatBytes},
+                       {"bytes_per_result_beat", d->link.bytesPerBeat},
                        {"formula", "transfer = batches * latency + max(0, box bytes / bandwidth - load cycles / clock) "
                                    "+ result bytes / bandwidth; device = (load + compute + drain cycles) / clock"}};
   }

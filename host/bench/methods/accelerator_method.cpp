@@ -8,14 +8,6 @@
 
 namespace bpaccel {
 
-double LinkModel::seconds(const RunStats& s, std::size_t bytesPerBeat, double clockHz) const {
-  const double boxLink = bytesPerBox * static_cast<double>(s.boxesSent) / bandwidthBytesPerSecond;
-  // The load port takes one box a cycle, hidden under a run or not: the link costs extra only when slower.
-  const double boxPort = static_cast<double>(s.boxesSent) / clockHz;
-  const double results = static_cast<double>(bytesPerBeat * s.beatsReceived) / bandwidthBytesPerSecond;
-  return static_cast<double>(s.batches) * latencySecondsPerRun + std::max(0.0, boxLink - boxPort) + results;
-}
-
 namespace {
 
 // The device's backend, recording its answers when the method runs paced.
@@ -53,8 +45,7 @@ void AcceleratorMethod::update(std::span<const Aabb> boxes) {
 }
 
 PipelineModel AcceleratorMethod::pipelineModel() const {
-  PipelineModel model{device_->clockHz, device_->link.bandwidthBytesPerSecond, device_->link.latencySecondsPerRun,
-                      device_->link.bytesPerBox, static_cast<double>(device_->beatBytes)};
+  PipelineModel model{.clockHz = device_->clockHz, .link = device_->link};
   model.decodeOnProducer = true;  // the schedule runPaced measures: HandOvers::Polled
   return model;
 }
@@ -65,7 +56,7 @@ FrameTime AcceleratorMethod::frameTime(double measuredSeconds) const {
   p.hostSeconds = measuredSeconds - timing_.times().backendSeconds;  // simulating the device is not host work
   p.partitionSeconds = timing_.times().partitionSeconds;
   p.deviceSeconds = static_cast<double>(p.stats.deviceCycles()) / device_->clockHz;
-  p.transferSeconds = device_->link.seconds(p.stats, device_->beatBytes, device_->clockHz);
+  p.transferSeconds = transferSeconds(p.stats, device_->link, device_->clockHz);
   p.pipeline = std::make_shared<const FrameTimeline>(modelPipeline(timing_.handOvers(), p.hostSeconds, pipelineModel()));
   return {p.hostSeconds + p.deviceSeconds + p.transferSeconds, p};
 }

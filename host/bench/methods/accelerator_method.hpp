@@ -18,20 +18,6 @@
 
 namespace bpaccel {
 
-/// Modelled link between host and accelerator. Boxes stream through the
-/// device's load port, one box a cycle (24 bytes with 32-bit keys), while they arrive: the load
-/// cycles are device time, and the link adds only what it is slower than the
-/// port. Each hand-over (a batch of cells, or a single run) pays a latency
-/// (command and completion); result beats come back over the link.
-///   transfer = hand-overs * latency + max(0, box bytes / bandwidth - load cycles / clock)
-///            + result bytes / bandwidth
-struct LinkModel {
-  double bandwidthBytesPerSecond = 4e9;  // a PCIe Gen3 x4 link's order of magnitude
-  double latencySecondsPerRun = 1e-6;    // one command and one completion per hand-over
-  double bytesPerBox = 24;               // six keys of the device's key width
-  double seconds(const RunStats& s, std::size_t bytesPerBeat, double clockHz) const;
-};
-
 /// A device clock and where it came from, for the table's legend.
 struct DeviceClock {
   double hz = 100e6;
@@ -55,11 +41,10 @@ std::string fpgaReportPath(int m, const std::string& arch, int keyWidth);
 struct DeviceConfig {
   std::string backend = "model";                      // where device cycles come from: rtl or model
   std::function<std::unique_ptr<Backend>()> makeBackend;
-  std::size_t beatBytes = 0;                          // bytes of one result beat
   nlohmann::json hardware;                            // m, capacity, ... as the JSON reports them
   double clockHz = 100e6;
   std::string clockSource = "default 100 MHz";
-  LinkModel link;
+  LinkModel link;                                     // with the device's bytes a box and a result beat
   /// Cells per hand-over to the device (the hardware's batch front end);
   /// 1 hands each cell over on its own, as before batches existed.
   std::size_t cellsPerBatch = 1;
@@ -84,7 +69,7 @@ class AcceleratorMethod final : public TimedMethod {
   void update(std::span<const Aabb> boxes) override;
   void pairs(std::vector<Pair>& out) override { out = pairs_; }
   /// Host = measured wall time minus the time spent simulating the device;
-  /// device = every busy cycle (loads included) / clock; transfer = LinkModel.
+  /// device = every busy cycle (loads included) / clock; transfer = transferSeconds.
   FrameTime frameTime(double measuredSeconds) const override;
   bool hasPacedRun() const override { return pacedPhase_ != nullptr; }
   void readyPacedDevice() override {

@@ -40,8 +40,7 @@ void RecordingBackend::runBatch(std::span<const std::span<const KeyBox>> cells, 
 
 PacedBackend::PacedBackend(const AnswerRecording& recording, const Backend& recorded, const PipelineModel& model)
     : recording_(recording), recorded_(recorded), model_(model) {
-  if (!(model.clockHz > 0) || !(model.bandwidthBytesPerSecond > 0) || model.latencySeconds < 0)
-    throw std::invalid_argument("paced device: clock and bandwidth must be positive, latency not negative");
+  checkLink(model.link, model.clockHz, "paced backend");
   prctl(PR_SET_TIMERSLACK, 1UL);  // this thread's sleeps end on time, not up to 50 us late
 }
 
@@ -62,7 +61,7 @@ void PacedBackend::runBatch(std::span<const std::span<const KeyBox>> cells, std:
   const BatchResult& r = recording_[next_++];
   append(r, out, cellEnds, stats);
   const auto t = handOverTimes(r.stats, model_);
-  const double hold = 2 * model_.latencySeconds + t.loadSeconds + std::max(t.computeSeconds, t.resultsSeconds);
+  const double hold = 2 * model_.link.latencySeconds + t.loadSeconds + std::max(t.computeSeconds, t.resultsSeconds);
   const auto until = reached + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(hold));
   std::this_thread::sleep_until(until - kSpin);
   while (Clock::now() < until) {

@@ -5,18 +5,6 @@
 
 namespace bpaccel {
 
-HandOverTimes handOverTimes(const RunStats& s, const PipelineModel& model) {
-  HandOverTimes t;
-  t.boxesSeconds = model.bytesPerBox * static_cast<double>(s.boxesSent) / model.bandwidthBytesPerSecond;
-  // The port takes one box a cycle, partly under runs (overlapped loads);
-  // a link slower than that adds its shortfall in full.
-  const double port = static_cast<double>(s.boxesSent) / model.clockHz;
-  t.loadSeconds = static_cast<double>(s.loadCycles) / model.clockHz + std::max(0.0, t.boxesSeconds - port);
-  t.computeSeconds = static_cast<double>(s.cycles) / model.clockHz;
-  t.resultsSeconds = model.bytesPerBeat * static_cast<double>(s.beatsReceived) / model.bandwidthBytesPerSecond;
-  return t;
-}
-
 namespace {
 
 // The link and the device, shared by both hosts: each run takes them in turn.
@@ -25,14 +13,14 @@ class DeviceLanes {
   DeviceLanes(const PipelineModel& model, FrameTimeline& t) : model_(model), t_(t) {}
   // Run i handed over at `ready`: returns when its answer reaches the host.
   double run(std::size_t i, const RunStats& s, double ready) {
-    const auto [boxes, load, compute, results] = handOverTimes(s, model_);
-    const double start = std::max({ready + model_.latencySeconds, linkFree_, deviceFree_});
+    const auto [boxes, excess, load, compute, results] = handOverTimes(s, model_);
+    const double start = std::max({ready + model_.link.latencySeconds, linkFree_, deviceFree_});
     t_.link.push_back({start, start + boxes, i});
     if (results > 0) t_.link.push_back({start + load, start + load + results, i});
     t_.device.push_back({start, start + load + compute, i});
     deviceFree_ = start + load + compute;
     linkFree_ = std::max(start + boxes, start + load + results);
-    return std::max(deviceFree_, start + load + results) + model_.latencySeconds;
+    return std::max(deviceFree_, start + load + results) + model_.link.latencySeconds;
   }
 
  private:
@@ -80,8 +68,7 @@ FrameTimeline modelPolled(const std::vector<HandOverRecord>& runs, double hostSe
 }  // namespace
 
 FrameTimeline modelPipeline(const std::vector<HandOverRecord>& runs, double hostSeconds, const PipelineModel& model) {
-  if (!(model.clockHz > 0) || !(model.bandwidthBytesPerSecond > 0) || model.latencySeconds < 0)
-    throw std::invalid_argument("pipeline model: clock and bandwidth must be positive, latency not negative");
+  checkLink(model.link, model.clockHz, "pipeline model");
   if (model.batchesInFlight < 1) throw std::invalid_argument("pipeline model: at least one batch in flight");
   if (model.decodeOnProducer) return modelPolled(runs, hostSeconds, model);
   FrameTimeline t;

@@ -8,16 +8,14 @@
 #include "broad_phase/broad_phase_config.hpp"
 #include "broad_phase/frame_observer.hpp"
 #include "core/types.hpp"
+#include "link_model.hpp"
 
 namespace bpaccel {
 
-/// What the device and the link are modelled with.
+/// What the device, the link and the host's schedule are modelled with.
 struct PipelineModel {
-  double clockHz = 100e6;
-  double bandwidthBytesPerSecond = 4e9;
-  double latencySeconds = 1e-6;  // each way: a command reaches the device, a completion the host
-  double bytesPerBox = 24;
-  double bytesPerBeat = 4;
+  double clockHz = 100e6;  // the device's
+  LinkModel link;
   std::size_t batchesInFlight = kBatchesInFlight;  // the host's bound (at least 1)
   /// The producer decodes the answers itself (HandOvers::Polled): after each
   /// hand-over those that have arrived, and for room or at the frame's end
@@ -25,14 +23,10 @@ struct PipelineModel {
   bool decodeOnProducer = false;
 };
 
-/// One hand-over's modelled parts, from its counters.
-struct HandOverTimes {
-  double boxesSeconds = 0;    // its boxes on the link
-  double loadSeconds = 0;     // the load port's busy cycles, and a slower link's shortfall
-  double computeSeconds = 0;  // the device's run cycles
-  double resultsSeconds = 0;  // its result beats on the link
-};
-HandOverTimes handOverTimes(const RunStats& stats, const PipelineModel& model);
+/// One hand-over's modelled parts (handOverTimes) at the model's clock.
+inline HandOverTimes handOverTimes(const RunStats& stats, const PipelineModel& model) {
+  return handOverTimes(stats, model.link, model.clockHz);
+}
 
 /// An interval of one lane of the timeline, for the plot.
 struct Span {

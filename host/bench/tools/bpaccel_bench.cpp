@@ -36,7 +36,7 @@ std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, do
   device->backend = backend;
   device->makeBackend = [backend] { return bpaccel::makeBuiltBackend(backend); };
   const bpaccel::DeviceParams built = bpaccel::builtDeviceParams();
-  device->beatBytes = built.resultBeatBytes();
+  device->link.bytesPerBeat = static_cast<double>(built.resultBeatBytes());
   device->link.bytesPerBox = static_cast<double>(built.loadBoxBytes());
   device->hardware = {{"m", BPACCEL_M},
                       {"capacity", BPACCEL_CAPACITY},
@@ -52,7 +52,7 @@ std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, do
     device->clockSource = std::move(clock.source);
   }
   device->link.bandwidthBytesPerSecond = linkGBytesPerSecond * 1e9;
-  device->link.latencySecondsPerRun = linkLatencyUs * 1e-6;
+  device->link.latencySeconds = linkLatencyUs * 1e-6;
   device->cellsPerBatch = cellsPerBatch;
   device->firstBatchCells = firstBatchCells;
   device->paced = paced && cellsPerBatch > 1;  // one cell a hand-over has nothing to overlap

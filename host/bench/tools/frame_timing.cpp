@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
   };
   bpaccel::PipelineModel model;  // the benchmark's link model (--link-gbytes-per-s 4, --link-latency-us 1)
   model.clockHz = clockMHz * 1e6;
-  model.bytesPerBeat = static_cast<double>(built.resultBeatBytes());
+  model.link.bytesPerBeat = static_cast<double>(built.resultBeatBytes());
   if (paced && (backendName != "model" || cellsPerBatch < 2)) {
     fmt::print(stderr, "frame_timing: --paced needs --backend model and --cells-per-batch of at least 2\n");
     return 2;
@@ -194,7 +194,7 @@ int main(int argc, char** argv) {
       t.phase = std::make_unique<bpaccel::BroadPhase>(*t.backend, config);
       if (paced) {
         bpaccel::PipelineModel deviceModel = model;
-        deviceModel.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(keyWidth));
+        deviceModel.link.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(keyWidth));
         for (const auto kind : {bpaccel::HandOvers::Asynchronous, bpaccel::HandOvers::Polled}) {
           auto run = std::make_unique<Timed::Paced>();
           bpaccel::BroadPhaseConfig pacedConfig = config;
@@ -232,7 +232,7 @@ int main(int argc, char** argv) {
         for (const auto& r : t.timing->handOvers()) decoded += r.decodeSeconds;
         t.decode.push_back(decoded);
         // The link carries the device's keys.
-        model.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(t.keyWidth));
+        model.link.bytesPerBox = static_cast<double>(bpaccel::loadBoxBytes(t.keyWidth));
         t.pipelined.push_back(bpaccel::modelPipeline(t.timing->handOvers(), hostSeconds, model).frameSeconds);
         bpaccel::PipelineModel polled = model;
         polled.decodeOnProducer = true;

@@ -38,7 +38,7 @@ std::shared_ptr<DeviceConfig> rtlDevice() {
   auto d = std::make_shared<DeviceConfig>();
   d->backend = "rtl";
   d->makeBackend = [] { return std::make_unique<RtlBackend>(); };
-  d->beatBytes = 4;
+  d->link.bytesPerBeat = 4;
   d->hardware = {{"m", BPACCEL_M}, {"capacity", BPACCEL_CAPACITY}};
   return d;
 }
@@ -507,7 +507,7 @@ TEST(LinkModel, ALinkSlowerThanTheLoadPortAddsOnlyItsExcess) {
   s.boxesSent = 1000;
   s.loadCycles = 1000;  // 10 us at 100 MHz through the load port
   s.beatsReceived = 500;
-  EXPECT_DOUBLE_EQ(link.seconds(s, 4, 100e6), 3 * 2e-6 + (24e-6 - 10e-6) + 2000.0 / 1e9);
+  EXPECT_DOUBLE_EQ(transferSeconds(s, link, 100e6), 3 * 2e-6 + (24e-6 - 10e-6) + 2000.0 / 1e9);
 }
 
 TEST(LinkModel, ALinkFasterThanTheLoadPortAddsNothingForBoxes) {
@@ -518,7 +518,7 @@ TEST(LinkModel, ALinkFasterThanTheLoadPortAddsNothingForBoxes) {
   s.boxesSent = 1000;
   s.loadCycles = 1000;
   s.beatsReceived = 0;
-  EXPECT_DOUBLE_EQ(link.seconds(s, 4, 100e6), 1e-6);
+  EXPECT_DOUBLE_EQ(transferSeconds(s, link, 100e6), 1e-6);
 }
 
 TEST(AcceleratorMethod, DeviceTimeCountsLoadCycles) {
@@ -543,7 +543,7 @@ TEST(AcceleratorMethod, BatchesPayTheLinkLatencyOncePerHandOverAndFindTheSamePai
     d->makeBackend = [] { return std::make_unique<ModelBackend>(builtDeviceParams()); };
     d->clockHz = 100e6;
     d->link.bandwidthBytesPerSecond = 1e12;  // the load port is slower: boxes add no link time
-    d->link.latencySecondsPerRun = 1e-6;
+    d->link.latencySeconds = 1e-6;
     d->cellsPerBatch = cellsPerBatch;
     AcceleratorMethod method(d, 16);
     method.update(boxes);

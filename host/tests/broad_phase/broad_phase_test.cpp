@@ -349,7 +349,7 @@ TEST(ModelPipeline, OverlapsHostLinkAndDeviceAsWorkedOutByHand) {
   EXPECT_NEAR(t.decode[1].end, 49e-6, 1e-12);
   EXPECT_NEAR(t.frameSeconds, 49e-6, 1e-12);
   // A latency each way: the first starts at 11 and completes at 37; the second starts at 36.
-  model.latencySeconds = 1e-6;
+  model.link.latencySeconds = 1e-6;
   t = modelPipeline({first, second}, host, model);
   EXPECT_NEAR(t.decode[0].start, 37e-6, 1e-12);
   EXPECT_NEAR(t.device[1].start, 36e-6, 1e-12);

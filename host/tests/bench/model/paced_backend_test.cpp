@@ -74,12 +74,12 @@ TEST(PacedBackend, AnswersWithTheRecordingNoSoonerThanItsModelledTime) {
 
   PipelineModel slow;  // a slow clock: the hold is long enough to tell from no hold at all
   slow.clockHz = 1e4;
-  slow.latencySeconds = 1e-4;
+  slow.link.latencySeconds = 1e-4;
   PacedBackend paced(recording, model, slow);
   EXPECT_EQ(paced.capacity(), model.capacity());
   EXPECT_EQ(paced.bipartite(), model.bipartite());
   const auto t = handOverTimes(recordedStats, slow);
-  const double hold = 2 * slow.latencySeconds + t.loadSeconds + std::max(t.computeSeconds, t.resultsSeconds);
+  const double hold = 2 * slow.link.latencySeconds + t.loadSeconds + std::max(t.computeSeconds, t.resultsSeconds);
   ASSERT_GT(hold, 1e-3);
   std::vector<Pair> got;
   std::vector<std::size_t> ends;
