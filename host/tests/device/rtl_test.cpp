@@ -26,7 +26,7 @@ namespace {
 
 // The keys the device compares: the host's, narrowed as one cell where the
 // device's are narrower (BroadPhase narrows each cell the same way).
-std::vector<KeyBox> keysOf(const std::vector<Aabb>& boxes) {
+std::vector<KeyBox> deviceKeysOf(const std::vector<Aabb>& boxes) {
   std::vector<KeyBox> keys;
   toKeys(boxes, keys);
   if constexpr (BPACCEL_KEY_WIDTH < 32) {
@@ -42,7 +42,7 @@ std::vector<KeyBox> keysOf(const std::vector<Aabb>& boxes) {
 // BroadPhase the tests below expect the floats' pairs at any key width.
 std::vector<Pair> devicePairs(const std::vector<Aabb>& boxes) {
   if constexpr (BPACCEL_KEY_WIDTH == 32) return bruteForce(boxes);
-  const auto keys = keysOf(boxes);
+  const auto keys = deviceKeysOf(boxes);
   std::vector<Pair> pairs;
   for (std::uint32_t i = 0; i < keys.size(); ++i)
     for (std::uint32_t j = i + 1; j < keys.size(); ++j)
@@ -57,7 +57,7 @@ struct BothRuns {
 };
 
 BothRuns runBoth(Backend& rtl, Backend& model, const std::vector<Aabb>& boxes) {
-  const auto keys = keysOf(boxes);
+  const auto keys = deviceKeysOf(boxes);
   BothRuns r;
   rtl.run(keys, r.fromRtl, r.rtlStats);
   model.run(keys, r.fromModel, r.modelStats);
@@ -157,7 +157,7 @@ TEST(RtlBackend, RecoversAfterAHungRunAndRunsTheNextBatchExactly) {
   const auto dense = adversarialScenes(60, 9).at(1).second;  // clusters: a hit the consumer never takes
   std::vector<Pair> pairs;
   RunStats stats;
-  EXPECT_THROW(rtl.run(keysOf(dense), pairs, stats), std::runtime_error);
+  EXPECT_THROW(rtl.run(deviceKeysOf(dense), pairs, stats), std::runtime_error);
   EXPECT_TRUE(pairs.empty());  // no partial answer is left behind
   EXPECT_EQ(stats.runs, 0u);
   consumerStuck = false;
@@ -193,7 +193,7 @@ TEST(RtlBackend, BipartiteRunsAgreeWithTheModelAndTestOnlyAcrossTheSplit) {
   ModelBackend model(builtDeviceParams());
   ASSERT_EQ(rtl.bipartite(), BPACCEL_BIPARTITE_RUNS != 0);
   ASSERT_EQ(model.bipartite(), rtl.bipartite());
-  const auto keys = keysOf(adversarialScenes(3 * BPACCEL_M + 5, 21).at(1).second);  // clusters: many hits
+  const auto keys = deviceKeysOf(adversarialScenes(3 * BPACCEL_M + 5, 21).at(1).second);  // clusters: many hits
   std::vector<Pair> pairs;
   RunStats stats;
   if (!rtl.bipartite()) {
@@ -212,7 +212,7 @@ TEST(RtlBackend, BipartiteRunsAgreeWithTheModelAndTestOnlyAcrossTheSplit) {
       if (split < 1 || split >= n) continue;
       const auto boxes = adversarialScenes(n, static_cast<unsigned>(n + split)).at(1).second;
       const auto label = fmt::format("n={} split={}", n, split);
-      const auto k = keysOf(boxes);
+      const auto k = deviceKeysOf(boxes);
       BothRuns r;
       rtl.runBipartite(k, split, r.fromRtl, r.rtlStats);
       model.runBipartite(k, split, r.fromModel, r.modelStats);
@@ -281,7 +281,7 @@ Batch randomBatch(std::size_t cells, unsigned seed, bool withFullCell) {
     auto scenes = adversarialScenes(n, static_cast<unsigned>(rng()));
     b.boxes.push_back(std::move(scenes.at(rng() % scenes.size()).second));
   }
-  for (const auto& c : b.boxes) b.keys.push_back(keysOf(c));
+  for (const auto& c : b.boxes) b.keys.push_back(deviceKeysOf(c));
   for (const auto& c : b.keys) b.spans.emplace_back(c);
   return b;
 }
