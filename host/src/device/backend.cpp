@@ -19,7 +19,13 @@ std::uint64_t scheduleIssueCycles(std::uint64_t n, std::uint64_t m, std::uint64_
   return fullCycles + (blocks - full) * (n - 1) - m * (blocks * (blocks - 1) / 2 - full * (full - 1) / 2);
 }
 
-void Backend::runBipartite(std::span<const KeyBox>, std::size_t, std::vector<Pair>&, RunStats&) {
+void Backend::runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                           RunStats& stats) {
+  checkBipartite(boxes.size(), split);
+  runSplit(boxes, split, out, stats);
+}
+
+void Backend::runSplit(std::span<const KeyBox>, std::size_t, std::vector<Pair>&, RunStats&) {
   throw std::logic_error(fmt::format("{}: no bipartite runs on this backend", name()));
 }
 

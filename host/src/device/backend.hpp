@@ -52,11 +52,13 @@ class Backend {
   virtual bool bipartite() const { return false; }
   /// One bipartite run (one run, one batch): appends only the overlapping
   /// pairs (i, j) with i < split <= j, for 1 <= split < boxes.size(). Where
-  /// bipartite() is false it throws std::logic_error.
-  virtual void runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
-                            RunStats& stats);
+  /// bipartite() is false it throws std::logic_error (checkBipartite), else runs runSplit.
+  void runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats);
 
  protected:
+  /// For backends with bipartite runs: one run of `boxes` with `split` (one
+  /// runBipartite has checked). By default throws std::logic_error.
+  virtual void runSplit(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats);
   /// For implementations of runBipartite: throws unless bipartite() and 1 <= split < n.
   void checkBipartite(std::size_t n, std::size_t split) const;
   /// For implementations: throws std::invalid_argument, naming the box, when

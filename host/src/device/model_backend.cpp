@@ -10,17 +10,11 @@ namespace bpaccel {
 ModelBackend::ModelBackend(const DeviceParams& params) : params_(params) { params_.check(); }
 
 void ModelBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) {
-  runAlone(boxes, 0, out, stats);
+  runSplit(boxes, 0, out, stats);
 }
 
-void ModelBackend::runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
-                                RunStats& stats) {
-  checkBipartite(boxes.size(), split);
-  runAlone(boxes, split, out, stats);
-}
-
-void ModelBackend::runAlone(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
-                            RunStats& stats) const {
+void ModelBackend::runSplit(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                            RunStats& stats) {
   runCell(boxes, split, out, stats);
   stats.loadCycles += boxes.size() + 1;  // one box a cycle, then the start cycle
   stats.cycles += busyCycles(boxes.size(), split);

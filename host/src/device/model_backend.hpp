@@ -32,15 +32,13 @@ class ModelBackend final : public Backend {
                 std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) override;
   /// Where the device has them (DeviceParams::bipartiteRuns: the stream architecture's).
   bool bipartite() const override { return params_.bipartiteRuns; }
-  void runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
-                    RunStats& stats) override;
 
  private:
   /// One cell's pairs and counters (split 0: all pairs), without counting it
   /// as a run; its load cycles and cycles depend on the hand-over (run, or batchCycles).
   void runCell(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats) const;
   /// One cell as its own run and hand-over: runCell plus its loads and busy cycles.
-  void runAlone(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats) const;
+  void runSplit(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats) override;
   /// All busy cycles of a run of n objects.
   std::uint64_t busyCycles(std::uint64_t n, std::uint64_t split = 0) const;
   /// One hardware batch's load and run cycles, cell by cell on the device's

@@ -127,17 +127,11 @@ void RtlBackend::reset() {
 }
 
 void RtlBackend::run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) {
-  runGuarded(boxes, 0, out, stats);
+  runSplit(boxes, 0, out, stats);
 }
 
-void RtlBackend::runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
-                              RunStats& stats) {
-  checkBipartite(boxes.size(), split);
-  runGuarded(boxes, split, out, stats);
-}
-
-void RtlBackend::runGuarded(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
-                            RunStats& stats) {
+void RtlBackend::runSplit(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
+                          RunStats& stats) {
   const std::size_t n = boxes.size();
   if (n > capacity())
     throw std::length_error(fmt::format("rtl: {} boxes exceed the hardware capacity {}", n, capacity()));

@@ -42,9 +42,6 @@ class RtlBackend final : public Backend {
   /// BPACCEL_BIPARTITE_RUNS: the stream architecture's hardware.
   bool bipartite() const override;
   unsigned keyWidth() const override;
-  /// One start with the split; the same reset on failure as run().
-  void runBipartite(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out,
-                    RunStats& stats) override;
 
   static std::size_t lanes();
   static std::size_t batchCells();
@@ -56,7 +53,9 @@ class RtlBackend final : public Backend {
   void settle();  // evaluate combinational outputs for the current inputs
   void tick();    // one rising clock edge
   void reset();
-  void runGuarded(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats);
+  /// One start with the split (0: all pairs); on any failure the device is
+  /// reset before the exception leaves, as in run().
+  void runSplit(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats) override;
   void runOnHardware(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats);
   void batchOnHardware(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
                        std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats);
