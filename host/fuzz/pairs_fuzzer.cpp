@@ -221,19 +221,26 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (cell) cells.push_back(cell);
   for (const auto& c : cells) {
     const std::string cellName = c ? std::to_string(*c) : "none";
-    setups.push_back({"cpu cell " + cellName, [&cpu, c] { return std::make_unique<BroadPhase>(cpu, BroadPhaseConfig{.cellSize = c}); }});
+    setups.push_back({"cpu cell " + cellName,
+                      [&cpu, c] { return std::make_unique<BroadPhase>(cpu, BroadPhaseConfig{.cellSize = c}); }});
     setups.push_back({fmt::format("model {} m {} capacity {} keys {} cell {} batch {}/{}", arch, m, capacity, keyWidth,
                                   cellName, cellsPerBatch, batchCells),
-                      [&model, c, cellsPerBatch] { return std::make_unique<BroadPhase>(model, BroadPhaseConfig{.cellSize = c, .cellsPerBatch = cellsPerBatch}); }});
+                      [&model, c, cellsPerBatch] {
+                        return std::make_unique<BroadPhase>(model,
+                                                            BroadPhaseConfig{.cellSize = c, .cellsPerBatch = cellsPerBatch});
+                      }});
   }
   if (cell) {
     setups.push_back({"cpu grid cell " + std::to_string(*cell), [&cpu, cell] {
-                        return std::make_unique<BroadPhase>(cpu, BroadPhaseConfig{.cellSize = cell, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 1});
+                        return std::make_unique<BroadPhase>(
+                            cpu, BroadPhaseConfig{.cellSize = cell, .partition = PartitionKind::UniformGrid});
                       }});
     setups.push_back({fmt::format("model {} m {} capacity {} keys {} grid cell {} batch {}/{}", arch, m, capacity,
                                   keyWidth, *cell, cellsPerBatch, batchCells),
                       [&model, cell, cellsPerBatch] {
-                        return std::make_unique<BroadPhase>(model, BroadPhaseConfig{.cellSize = cell, .partition = PartitionKind::UniformGrid, .cellsPerBatch = cellsPerBatch});
+                        return std::make_unique<BroadPhase>(model, BroadPhaseConfig{.cellSize = cell,
+                                                                                    .partition = PartitionKind::UniformGrid,
+                                                                                    .cellsPerBatch = cellsPerBatch});
                       }});
   }
   if (threads > 1 && cell) {
@@ -241,7 +248,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     setups.push_back({fmt::format("model {} m {} capacity {} keys {} cell {} threads {} batch {}/{}", arch, m, capacity,
                                   keyWidth, *cell, threads, cellsPerBatch, batchCells),
                       [makeModel, cell, threads, cellsPerBatch] {
-                        return std::make_unique<BroadPhase>(makeModel, BroadPhaseConfig{.cellSize = cell, .threads = threads, .cellsPerBatch = cellsPerBatch});
+                        return std::make_unique<BroadPhase>(
+                            makeModel,
+                            BroadPhaseConfig{.cellSize = cell, .threads = threads, .cellsPerBatch = cellsPerBatch});
                       }});
   }
   if (const auto bad = firstBoxWithNaN(boxes)) {

@@ -152,7 +152,8 @@ TEST(BroadPhase, SeveralThreadsGiveExactlyTheSinglePairs) {
   for (std::size_t threads : {2u, 3u}) {
     BroadPhase cpu([] { return std::make_unique<CpuBackend>(); }, {.cellSize = 8, .threads = threads});
     // A small capacity: cells above it are chunked inside the workers.
-    BroadPhase model([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, {.cellSize = 16, .threads = threads});
+    BroadPhase model([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); },
+                     {.cellSize = 16, .threads = threads});
     EXPECT_EQ(cpu.threads(), threads);
     for (std::size_t n : {0u, 2u, 300u, 1000u})
       for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 7)) {
@@ -436,7 +437,8 @@ TEST(BroadPhase, SlowStartHandsOverFewCellsFirstThenTwiceAsManyEachTimeUpToTheBa
 }
 
 TEST(BroadPhase, BatchesWorkOnSeveralThreadsAndRejectZeroCellsPerBatch) {
-  BroadPhase model([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, {.cellSize = 16, .threads = 2, .cellsPerBatch = 5});
+  BroadPhase model([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); },
+                   {.cellSize = 16, .threads = 2, .cellsPerBatch = 5});
   for (std::size_t n : {0u, 2u, 300u, 1000u})
     for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 9)) {
       std::vector<Pair> pairs;
@@ -518,7 +520,8 @@ TEST(BroadPhase, AsynchronousAndPolledHandOversGiveTheSynchronousPairsCountersAn
 
 TEST(BroadPhase, AsynchronousAndPolledHandOversWorkOnSeveralThreads) {
   for (const HandOvers handOvers : {HandOvers::Asynchronous, HandOvers::Polled}) {
-    BroadPhase bp([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, {.cellSize = 16, .partition = PartitionKind::KdTree, .threads = 2, .cellsPerBatch = 5, .handOvers = handOvers});
+    BroadPhase bp([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); },
+                  {.cellSize = 16, .threads = 2, .cellsPerBatch = 5, .handOvers = handOvers});
     for (std::size_t n : {2u, 300u, 1000u})
       for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 23)) {
         std::vector<Pair> pairs;
@@ -534,7 +537,8 @@ TEST(BroadPhase, AsynchronousAndPolledHandOversPassADeviceFailureOnAndRecover) {
     for (std::size_t failAt : {1u, 2u, 3u}) {
       const std::string label = "failing hand-over " + std::to_string(failAt) +
                                 (handOvers == HandOvers::Polled ? " polled" : " decoder thread");
-      BroadPhase bp([failAt] { return std::make_unique<FailingModel>(failAt); }, {.cellSize = 8, .partition = PartitionKind::KdTree, .cellsPerBatch = 4, .handOvers = handOvers});
+      BroadPhase bp([failAt] { return std::make_unique<FailingModel>(failAt); },
+                    {.cellSize = 8, .cellsPerBatch = 4, .handOvers = handOvers});
       std::vector<Pair> pairs;
       EXPECT_THROW(bp.findPairs(boxes, pairs), std::runtime_error) << label;
       bp.findPairs(boxes, pairs);  // the device answers again: the next frame is whole
@@ -564,7 +568,8 @@ TEST(BroadPhase, NarrowKeyDevicesGiveExactlyTheFullKeyPairs) {
                                      std::optional<std::size_t>{16}})
               for (const std::size_t perBatch : {1u, 8u}) {
                 const auto handOvers = perBatch > 1 ? HandOvers::Asynchronous : HandOvers::Synchronous;
-                BroadPhase bp(make, {.cellSize = cell, .partition = partition, .cellsPerBatch = perBatch, .handOvers = handOvers});
+                BroadPhase bp(make,
+                              {.cellSize = cell, .partition = partition, .cellsPerBatch = perBatch, .handOvers = handOvers});
                 std::vector<Pair> pairs;
                 bp.findPairs(boxes, pairs);
                 const std::string label = name + " n=" + std::to_string(n) + " width " + std::to_string(width) +

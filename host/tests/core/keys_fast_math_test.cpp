@@ -1,4 +1,4 @@
-// Built, with host/src/keys.cpp, under -ffast-math, as many game engines
+// Built, with host/src/core/keys.cpp, under -ffast-math, as many game engines
 // build everything: the key conversion must not depend on float semantics
 // that fast-math lets the compiler drop (signed zeros, NaN).
 

@@ -513,7 +513,8 @@ TEST(RtlBatch, RunsOnItsOwnThreadBehindAnAsyncBackendWithTheSameResults) {
   sync.findPairs(boxes, expected);
   {
     // The Verilated model is built, run and destroyed on the hand-overs' own thread.
-    BroadPhase async([] { return std::make_unique<RtlBackend>(); }, {.cellSize = 2 * BPACCEL_M, .partition = PartitionKind::KdTree, .cellsPerBatch = 3, .handOvers = HandOvers::Asynchronous});
+    BroadPhase async([] { return std::make_unique<RtlBackend>(); },
+                     {.cellSize = 2 * BPACCEL_M, .cellsPerBatch = 3, .handOvers = HandOvers::Asynchronous});
     async.findPairs(boxes, pairs);
     EXPECT_EQ(pairs, expected);
     EXPECT_EQ(async.stats().deviceCycles(), sync.stats().deviceCycles());

@@ -331,7 +331,8 @@ TEST(UniformGrid, BatchesAndThreadsGiveExactlyTheBruteForcePairs) {
       BroadPhase batched(model, {.cellSize = 16, .partition = PartitionKind::UniformGrid, .cellsPerBatch = 7});
       batched.findPairs(boxes, pairs);
       EXPECT_EQ(sorted(pairs), exact) << name << " batched";
-      BroadPhase threaded([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); }, {.cellSize = 16, .partition = PartitionKind::UniformGrid, .threads = 2, .cellsPerBatch = 5});
+      BroadPhase threaded([] { return std::make_unique<ModelBackend>(DeviceParams::seed(2, 6, 5)); },
+                          {.cellSize = 16, .partition = PartitionKind::UniformGrid, .threads = 2, .cellsPerBatch = 5});
       threaded.findPairs(boxes, pairs);
       EXPECT_EQ(sorted(pairs), exact) << name << " 2 threads";
     }
