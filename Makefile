@@ -44,7 +44,7 @@ SCALA_SOURCES := $(wildcard src/bpaccel/*.scala) build.sbt
 
 # Debian's interpreter, which has python3-matplotlib.
 PYTHON := /usr/bin/python3
-# Extra options for `bpaccel bench` (see `build/bin/bpaccel bench --help`).
+# Extra options for `bpaccel-bench run` (see `build/bench-bin/bpaccel-bench run --help`).
 BENCH_ARGS ?=
 
 # The FPGA flow's own test runs on this configuration.
@@ -72,7 +72,7 @@ test-hw: deps
 formal-long: deps
 	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec"
 
-# The C++ host (build/bin/bpaccel) with the Verilated accelerator, and its tests.
+# The C++ host (build/bin/bpaccel, build/bin/bpaccel-bench) with the Verilated accelerator, and its tests.
 $(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
 	$(SBT) "runMain bpaccel.EmitVerilog --arch $(ARCH) --m $(M) --capacity $(CAPACITY) --key-width $(KEY_WIDTH) --target-dir $(HOST_VERILOG)"
 
@@ -97,9 +97,9 @@ bench: deps
 	$(MAKE) bench-run ARCH=$(BENCH_ARCH) M=$(BENCH_M) HOST_BIN_DIR=$(BENCH_BIN_DIR)
 
 bench-run: host
-	mkdir -p results; set -o pipefail; $(HOST_BIN_DIR)/bpaccel bench --json results/bench.json $(BENCH_ARGS) | tee results/bench.txt
+	mkdir -p results; set -o pipefail; $(HOST_BIN_DIR)/bpaccel-bench run --json results/bench.json $(BENCH_ARGS) | tee results/bench.txt
 	$(PYTHON) scripts/plot_bench.py --json results/bench.json --out-dir results
-	$(HOST_BIN_DIR)/bpaccel scene --objects 100 --frames 30 --out results/scene.json
+	$(HOST_BIN_DIR)/bpaccel-bench scene --objects 100 --frames 30 --out results/scene.json
 	$(PYTHON) scripts/render_scene.py --json results/scene.json --out results/scene.png
 
 # The seed's sizes, 100,000 and 1,000,000 objects: device cycles from the
@@ -113,7 +113,7 @@ bench-large: deps
 	$(MAKE) bench-large-run ARCH=$(BENCH_ARCH) M=$(BENCH_M) HOST_BIN_DIR=$(BENCH_BIN_DIR)
 
 bench-large-run: host
-	mkdir -p results/large; set -o pipefail; $(HOST_BIN_DIR)/bpaccel bench --json results/large/bench.json $(BENCH_LARGE_ARGS) | tee results/large/bench.txt
+	mkdir -p results/large; set -o pipefail; $(HOST_BIN_DIR)/bpaccel-bench run --json results/large/bench.json $(BENCH_LARGE_ARGS) | tee results/large/bench.txt
 	$(PYTHON) scripts/plot_bench.py --json results/large/bench.json --out-dir results/large
 
 # The same host, Verilated model and tests under AddressSanitizer and
