@@ -112,10 +112,11 @@ class ShellCore(p: ShellParams) extends Module {
     }
   }
 
-  // After the last item: the rest of its beat is zero and ends the packet.
+  // After the last item: the rest of its beat is zero and ends the packet
+  // (a whole beat after it, when it ended a beat, is one too many).
   when(state === State.Padding && !aborting && window.count =/= 0.U) {
     consume := window.restOfBeat
-    when(window.restZero && window.beatLast) {
+    when(window.restZero && window.beatLast && window.restOfBeat =/= p.wordsPerBeat.U) {
       state := State.Done
     }.otherwise {
       fail(Protocol.LengthMismatch.code.U, adapter.io.position)
