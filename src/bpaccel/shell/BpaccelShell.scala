@@ -152,7 +152,8 @@ class BpaccelShell(val p: ShellParams) extends RawModule {
     )
     for ((name, _) <- ShellRegisters.counterNames) hw(name) := counters(name)
 
-    hw("STATUS_READY")      := open
+    // Low from the cycle after a SOFT_RESET write, so a STATUS read after its response sees the reset.
+    hw("STATUS_READY")      := open && !softRequest && !hw("CONTROL_SOFT_RESET")(0)
     hw("STATUS_BUSY")       := busy
     hw("STATUS_IN_PACKET")  := inPacket
     hw("STATUS_REPLY_OPEN") := replyOpen

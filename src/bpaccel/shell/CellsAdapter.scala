@@ -142,7 +142,7 @@ class CellsAdapter(p: ShellParams) extends CoreAdapter(p, p.recordWords) {
   private val r    = results.io.deq.bits
   private val idx  = if (p.indexWords == 1) Seq(Cat(r.beat.jBase.pad(16), r.beat.iBase.pad(16))) else Seq(r.beat.iBase.pad(32), r.beat.jBase.pad(32))
   private val mask = r.beat.mask.pad(32 * p.maskWords)
-  io.records.valid      := results.io.deq.valid
+  io.records.valid      := results.io.deq.valid && !cancelling // none after a cancel: the summary counts them all
   io.records.bits.words := VecInit(idx ++ Seq(r.cell) ++ (0 until p.maskWords).map(i => mask(32 * i + 31, 32 * i)))
   io.records.bits.count := p.recordWords.U
   results.io.deq.ready  := io.records.ready

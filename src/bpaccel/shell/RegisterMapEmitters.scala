@@ -77,12 +77,7 @@ object RegisterMapEmitters {
        |half, which `<NAME>_HI` returns, so read lo then hi. One shadow serves all
        |counters: read each pair without another `_LO` read between.
        |
-       || offset | register | access | reset | meaning |
-       || --- | --- | --- | --- | --- |
-       |${summary.mkString("\n")}
-       |
-       |## Fields
-       |
-       |${details.mkString("\n")}""".stripMargin
+       |""".stripMargin + "| offset | register | access | reset | meaning |\n| --- | --- | --- | --- | --- |\n" +
+      summary.mkString("\n") + "\n\n## Fields\n\n" + details.mkString("\n")
   }
 }

@@ -83,7 +83,7 @@ object ShellRegisters {
     val control = Seq(
       Register("CONTROL", ControlOffset, "actions; each bit starts its action once and reads 0", Seq(
         Field("ABORT", 0, 1, WriteOnePulse, "end the current command at once: its reply is the records so far and a trailer with ABORTED; the rest of its packet is drained"),
-        Field("SOFT_RESET", 1, 1, WriteOnePulse, "reset the datapath of both clock domains, the FIFOs, STATUS, LAST_REPLY, IRQ_STATUS and the counters (not IRQ_ENABLE); the streams drop what they hold")
+        Field("SOFT_RESET", 1, 1, WriteOnePulse, "reset the datapath of both clock domains, the FIFOs, STATUS, LAST_REPLY, LAST_DETAIL and the counters; IRQ_ENABLE and IRQ_STATUS keep their bits; the streams drop what they hold (halt and flush the DMA first, then wait for STATUS.READY)")
       )),
       Register("STATUS", ControlOffset + 0x4, "state of the streams and the core", Seq(
         Field("READY", 0, 1, ReadOnly, "both clock domains are out of reset: the input stream may send"),

@@ -1,0 +1,39 @@
+# The AXI shell (docs/integration.md): its Verilog, register page, FuseSoC core,
+# tests and a quick synthesis. Included by the Makefile.
+.PHONY: shell-verilog shell-registers test-shell shell-fusesoc shell-synth
+
+# The shell's configuration (EmitShell --help lists every option).
+SHELL_ARCH     ?= stream
+SHELL_M        ?= 8
+SHELL_CAPACITY ?= 64
+SHELL_STREAM_BITS ?= 128
+SHELL_DUAL_CLOCK  ?= true
+SHELL_DIR      ?= build/shell/$(SHELL_ARCH)-m$(SHELL_M)-w$(SHELL_STREAM_BITS)
+SHELL_TESTBENCH := test/fusesoc/bpaccel_shell_smoke_tb.sv
+SHELL_VENV     := build/shell-venv/bin
+
+# SystemVerilog, bpaccel_params.h, bpaccel_shell.h, bpaccel_shell.rdl, registers.md and bpaccel_shell.core.
+shell-verilog: deps
+	$(SBT) "runMain bpaccel.shell.EmitShell --arch $(SHELL_ARCH) --m $(SHELL_M) --capacity $(SHELL_CAPACITY) --stream-bits $(SHELL_STREAM_BITS) --dual-clock $(SHELL_DUAL_CLOCK) --target-dir $(SHELL_DIR) --smoke-testbench $(SHELL_TESTBENCH)"
+	cd $(SHELL_DIR) && verilator --lint-only -Wall lint_waivers.vlt -F filelist.f --top-module BpaccelShell
+	@echo "Shell for arch=$(SHELL_ARCH), m=$(SHELL_M), $(SHELL_STREAM_BITS)-bit streams: $(SHELL_DIR)/filelist.f"
+
+# docs/registers.md, from the default configuration's register map.
+shell-registers: deps
+	$(SBT) "runMain bpaccel.shell.EmitShell --target-dir build/shell/registers"
+	cp build/shell/registers/registers.md docs/registers.md
+
+# The shell's own tests (also part of `make test` through test-hw): lint, no
+# combinational port-to-port path, cocotb on Icarus, PeakRDL, FuseSoC.
+test-shell: deps
+	$(SBT) "testOnly bpaccel.shell.*"
+
+# FuseSoC's lint and sim targets on one emitted configuration.
+shell-fusesoc: shell-verilog
+	mkdir -p $(SHELL_DIR)/fusesoc && cd $(SHELL_DIR)/fusesoc && \
+	  $(abspath $(SHELL_VENV))/fusesoc --cores-root .. run --target lint bpaccel:accel:bpaccel_shell && \
+	  $(abspath $(SHELL_VENV))/fusesoc --cores-root .. run --target sim bpaccel:accel:bpaccel_shell
+
+# Yosys synthesis for the LFE5UM5G-85F (no place and route): cells of the shell alone and with its core.
+shell-synth: shell-verilog
+	cd $(SHELL_DIR) && yosys -q -l synth_ecp5.log -p "read_verilog -sv $$(grep '\.sv$$' filelist.f | tr '\n' ' '); synth_ecp5 -top BpaccelShell; tee -o synth_ecp5_stat.txt stat" && tail -40 synth_ecp5_stat.txt
