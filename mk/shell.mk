@@ -1,6 +1,6 @@
 # The AXI shell (docs/integration.md): its Verilog, register page, FuseSoC core,
 # tests and a quick synthesis. Included by the Makefile.
-.PHONY: shell-verilog shell-registers test-shell shell-fusesoc shell-synth
+.PHONY: shell-verilog shell-registers test-shell shell-fusesoc shell-synth shell-measure
 
 # The shell's configuration (EmitShell --help lists every option).
 SHELL_ARCH     ?= stream
@@ -37,3 +37,11 @@ shell-fusesoc: shell-verilog
 # Yosys synthesis for the LFE5UM5G-85F (no place and route): cells of the shell alone and with its core.
 shell-synth: shell-verilog
 	cd $(SHELL_DIR) && yosys -q -l synth_ecp5.log -p "read_verilog -sv $$(grep '\.sv$$' filelist.f | tr '\n' ' '); synth_ecp5 -top BpaccelShell; tee -o synth_ecp5_stat.txt stat" && tail -40 synth_ecp5_stat.txt
+
+# The cycles the shell adds to a bench-like batch (216 cells of about 54 boxes)
+# at m = 64 with 256-bit streams on one clock (test/cocotb/measure_shell.py).
+SHELL_MEASURE_DIR := build/shell/measure
+shell-measure: deps
+	$(SBT) "runMain bpaccel.shell.EmitShell --arch stream --m 64 --capacity 128 --stream-bits 256 --dual-clock false --target-dir $(SHELL_MEASURE_DIR)"
+	BPACCEL_TEST_MODULE=measure_shell BPACCEL_MEASURE_OUT=$(abspath $(SHELL_MEASURE_DIR))/shell_measure.txt \
+	  $(SHELL_VENV)/python test/cocotb/run.py $(SHELL_MEASURE_DIR)

@@ -27,7 +27,8 @@ def main():
         defines["DUAL_CLOCK"] = 1
     runner.build(sources=sources + [here / "bpaccel_shell_tb.sv"], hdl_toplevel="bpaccel_shell_tb", build_dir=build,
                  timescale=("1ns", "1ps"), build_args=["-g2012"], defines=defines, always=True)
-    results = runner.test(hdl_toplevel="bpaccel_shell_tb", test_module="test_shell", test_dir=build,
+    results = runner.test(hdl_toplevel="bpaccel_shell_tb", test_module=os.environ.get("BPACCEL_TEST_MODULE", "test_shell"),
+                          test_dir=build,
                           test_filter=os.environ.get("BPACCEL_TEST_FILTER"),
                           extra_env={"BPACCEL_SHELL_DIR": str(verilog), "PYTHONPATH": str(here)})
     failures = ET.parse(results).getroot().findall(".//failure") + ET.parse(results).getroot().findall(".//error")

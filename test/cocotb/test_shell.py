@@ -278,15 +278,16 @@ async def registers_describe_the_configuration(dut):
 async def pairs_match_brute_force_under_back_pressure(dut):
     """Random commands, several queued at once, random pauses on every stream; register counters add up."""
     s, rng = await started(dut, 1)
-    commands = [random_cells(rng, rng.randrange(1, 5), max_boxes=min(CFG.capacity, 24)) for _ in range(6)]
+    commands = [random_cells(rng, rng.randrange(1, 6)) for _ in range(16)]
     totals = {"PAIRS": 0, "BOXES": 0, "ISSUE_CYCLES": 0, "RECORDS": 0}
     for round_, probability in enumerate([0.0, 0.5]):
         s.backpressure(probability)
-        for cells in commands[3 * round_:3 * round_ + 3]:
+        batch = commands[8 * round_:8 * round_ + 8]
+        for cells in batch:
             cocotb.start_soon(s.send(cells_words(CFG, cells)))  # queued behind each other, as a DMA ring does
         await s.write("IRQ_ENABLE", 0)  # a register write while the write responses are held back too
         COVERAGE.hit("several commands queued", CFG.field("STATUS", "BUSY", await s.read("STATUS")) == 1)
-        for cells in commands[3 * round_:3 * round_ + 3]:
+        for cells in batch:
             reply = await s.reply()
             check_cells(cells, reply)
             if probability == 0.0 and CFG.words_per_beat >= CFG.record_words:

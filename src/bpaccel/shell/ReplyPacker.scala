@@ -40,7 +40,8 @@ class ReplyPacker(p: ShellParams, recordWords: Int) extends Module {
   val left    = Mux(emitted, Mux(fullBeat, count - k.U, 0.U), count)
 
   // Records join behind what stays.
-  io.records.ready := !sending && io.records.bits.count <= size.U - left
+  // Room for the longest record: a test on `left` alone.
+  io.records.ready := !sending && left <= (size - recordWords).U
   for (j <- 0 until size) {
     val kept = if (j + k < size) Mux(emitted, buffer(j + k), buffer(j)) else Mux(emitted, 0.U, buffer(j))
     val fromRecord = VecInit.tabulate(recordWords)(i => io.records.bits.words(i))

@@ -46,10 +46,15 @@ class ShellSpec extends AnyFlatSpec with Matchers {
   private def svFiles(dir: Path): Seq[String] =
     Files.readString(dir.resolve("filelist.f")).split("\\s+").filter(_.endsWith(".sv")).toSeq
 
-  /** Input -> output port pairs joined by logic alone in `top` (comb_paths.py on Yosys' flattened netlist). */
-  private def combinationalPaths(dir: Path, top: String): Seq[String] = {
+  /** Input -> output port pairs joined by logic alone in `top` (comb_paths.py on Yosys' flattened
+    * netlist). Modules in `blackBoxes` count as logic from each of their inputs to each of their
+    * outputs: more paths than they have, so none found is still a proof, and the core need not
+    * be read gate by gate.
+    */
+  private def combinationalPaths(dir: Path, top: String, blackBoxes: Seq[String] = Nil): Seq[String] = {
     val netlist = dir.resolve(s"$top.netlist.json")
-    val script = s"read_verilog -sv ${svFiles(dir).mkString(" ")}; hierarchy -top $top; proc; flatten; " +
+    val boxes = blackBoxes.map(b => s"blackbox $b; ").mkString
+    val script = s"read_verilog -sv ${svFiles(dir).mkString(" ")}; ${boxes}hierarchy -top $top; proc; flatten; " +
       s"memory -nomap; opt_clean; techmap; opt_clean; write_json $netlist"
     val (yosys, yosysLog) = run(Seq("yosys", "-q", "-p", script), dir)
     withClue(yosysLog) { yosys shouldBe 0 }
@@ -65,7 +70,7 @@ class ShellSpec extends AnyFlatSpec with Matchers {
     }
 
     it should "have no combinational path from an input port to an output port" in {
-      combinationalPaths(dir, EmitShell.top) shouldBe empty
+      combinationalPaths(dir, EmitShell.top, blackBoxes = Seq("BroadPhaseAccel")) shouldBe empty
     }
 
     it should "pass the cocotb testbench on Icarus" in {
