@@ -36,7 +36,9 @@ class AsyncFifo[T <: Data](gen: T, depth: Int) extends RawModule {
     RegNext(s0, 0.U(ptrBits.W)).suggestName(s"${name}_sync1")
   }
 
-  private val storage = withClock(io.enqClock) { Reg(Vec(depth, gen)) }
+  // Written on the writer's clock, read without a clock behind the reader's pointer: the
+  // shape of a LUT RAM with an asynchronous read port (TRELLIS_DPR16X4, Xilinx distributed RAM).
+  private val storage = Mem(depth, gen)
 
   private val writeGray = Wire(UInt(ptrBits.W))
   private val readGray  = Wire(UInt(ptrBits.W))
@@ -49,7 +51,7 @@ class AsyncFifo[T <: Data](gen: T, depth: Int) extends RawModule {
     val full = gray === (readSeen ^ (3.U(2.W) << (ptrBits - 2)))
     io.enq.ready := !full
     when(io.enq.fire) {
-      storage(bin(ptrBits - 2, 0)) := io.enq.bits
+      storage.write(bin(ptrBits - 2, 0), io.enq.bits, io.enqClock)
       bin  := bin + 1.U
       gray := toGray(bin + 1.U)
     }
@@ -61,7 +63,7 @@ class AsyncFifo[T <: Data](gen: T, depth: Int) extends RawModule {
     val gray = RegInit(0.U(ptrBits.W))
     val writeSeen = synchronize(writeGray, "writeGray")
     io.deq.valid := gray =/= writeSeen
-    io.deq.bits  := storage(bin(ptrBits - 2, 0))
+    io.deq.bits  := storage.read(bin(ptrBits - 2, 0))
     when(io.deq.fire) {
       bin  := bin + 1.U
       gray := toGray(bin + 1.U)

@@ -46,12 +46,14 @@ class BpaccelShell(val p: ShellParams) extends RawModule {
   private val (coreReset, coreAlive) =
     if (p.dualClock) {
       val released = withClockAndReset(coreClock, coreResetRequest.asAsyncReset) {
-        val stages = RegInit(VecInit(Seq.fill(2)(true.B)))
-        stages(0) := false.B
-        stages(1) := stages(0)
-        val alive = RegInit(false.B)
-        alive := !stages(1)
-        (stages(1), alive)
+        // A reset synchronizer: asserted at once (asynchronously), released on core_clk.
+        val sync0 = RegInit(true.B).suggestName("coreReset_sync0")
+        val sync1 = RegInit(true.B).suggestName("coreReset_sync1")
+        sync0 := false.B
+        sync1 := sync0
+        val alive = RegInit(false.B).suggestName("coreAlive")
+        alive := !sync1
+        (sync1, alive)
       }
       // Its synchronizer keeps its state through a soft reset, which waits to see the core side fall.
       (released._1, withClockAndReset(aclk, hardReset) { ShellSync(released._2, "coreAlive") })

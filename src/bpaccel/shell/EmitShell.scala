@@ -50,6 +50,8 @@ object EmitShell {
     "`verilator_config\n" +
       "// chisel3.util.Queue's memory reads combinationally: firtool's ram module has an unused read clock.\n" +
       "lint_off -rule UNUSEDSIGNAL -file \"*ram_*.sv\" -match \"*R0_clk*\"\n" +
+      "// So does the asynchronous FIFOs' storage (its read is on the reader's side, without a clock).\n" +
+      "lint_off -rule UNUSEDSIGNAL -file \"*storage_*.sv\" -match \"*R0_clk*\"\n" +
       "// The register bank keeps whole write beats; only the writable fields' bits are used.\n" +
       "lint_off -rule UNUSEDSIGNAL -file \"*AxiLiteRegisterBank.sv\" -match \"*wData*\"\n" +
       "lint_off -rule UNUSEDSIGNAL -file \"*AxiLiteRegisterBank.sv\" -match \"*wStrb*\"\n"
