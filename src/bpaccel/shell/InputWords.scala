@@ -21,24 +21,28 @@ class WordWindow(p: ShellParams) extends Bundle {
 
 /** Turns beats of k words into a window on the next words of the input.
   *
-  * A circular buffer of `parserBufferWords` words in beat-sized slots: a
-  * beat is written whole into the next free slot (taken only while a whole
-  * slot is free, a test on registers alone), and the consumer takes any
-  * number of words from the front each cycle. Packets start on a fresh
-  * beat, so a word's position in its beat is its position in the buffer
-  * modulo k.
+  * Beats are kept whole in `slots` slots of a ring (a beat is taken only
+  * while a whole slot is free, a test on registers alone), and the consumer
+  * takes any number of words from the front each cycle. The window reads the
+  * few beats it can reach (its first word's beat and the next ones, one slot
+  * multiplexer each) and picks its words by the front's offset in its beat,
+  * a k-way multiplexer per word: much less logic than a multiplexer per word
+  * over the whole ring at wide beats. Packets start on a fresh beat, so a
+  * word's position in its beat is its position in the ring modulo k.
   */
 class InputWords(p: ShellParams) extends Module {
   private val k     = p.wordsPerBeat
   private val size  = p.parserBufferWords
   private val slots = size / k
-  require(slots >= 2 && isPow2(size), "the word buffer holds at least two beats, a power of two of words")
+  /** Beats a window can touch: its first word at offset k-1 and itemWords words. */
+  private val reach = (k - 1 + p.itemWords + k - 1) / k
+  require(slots >= 2 && isPow2(slots) && reach <= slots, "the ring holds at least two beats and every beat a window touches")
   val io = IO(new Bundle {
     val in      = Flipped(Decoupled(new InputBeat(p.streamBits)))
     val window  = Output(new WordWindow(p))
     val consume = Input(UInt(log2Ceil(size + 1).W))
   })
-  val buffer    = Reg(Vec(size, UInt(32.W)))
+  val ring      = Reg(Vec(slots, Vec(k, UInt(32.W))))
   val slotLast  = Reg(Vec(slots, Bool()))
   val readPtr   = RegInit(0.U(log2Ceil(size).W))
   val writeSlot = RegInit(0.U(log2Ceil(slots).W))
@@ -46,7 +50,7 @@ class InputWords(p: ShellParams) extends Module {
 
   io.in.ready := count <= (size - k).U
   when(io.in.fire) {
-    for (s <- 0 until slots; j <- 0 until k) when(writeSlot === s.U) { buffer(s * k + j) := io.in.bits.data(32 * j + 31, 32 * j) }
+    ring(writeSlot)     := VecInit.tabulate(k)(j => io.in.bits.data(32 * j + 31, 32 * j))
     slotLast(writeSlot) := io.in.bits.last
     writeSlot := writeSlot + 1.U
   }
@@ -54,16 +58,18 @@ class InputWords(p: ShellParams) extends Module {
   readPtr := readPtr + io.consume
   count   := count - io.consume + Mux(io.in.fire, k.U, 0.U)
 
-  private val offset = if (k == 1) 0.U else readPtr(log2Ceil(k) - 1, 0)
+  private val offset = readPtr(log2Ceil(k) - 1, 0)
   private val slot   = readPtr >> log2Ceil(k)
+  private val beats  = Seq.tabulate(reach)(b => (ring((slot + b.U)(log2Ceil(slots) - 1, 0)), slotLast((slot + b.U)(log2Ceil(slots) - 1, 0))))
+  private val words  = beats.flatMap(_._1)
+  // Word w of the beats read ends its packet if it is its beat's last and that beat carried TLAST.
+  private val lastAt = Seq.tabulate(words.length)(w => if (w % k == k - 1) beats(w / k)._2 else false.B)
   for (i <- 0 until p.itemWords) {
-    val at = readPtr + i.U
-    io.window.words(i) := buffer(at)
-    io.window.last(i)  := slotLast(at >> log2Ceil(k)) && (if (k == 1) true.B else at(log2Ceil(k) - 1, 0).andR)
+    io.window.words(i) := VecInit.tabulate(k)(o => words(o + i))(offset)
+    io.window.last(i)  := VecInit.tabulate(k)(o => lastAt(o + i))(offset)
   }
   io.window.count      := count
   io.window.restOfBeat := k.U - offset
-  private val beatWords = VecInit.tabulate(k)(j => VecInit.tabulate(slots)(s => buffer(s * k + j))(slot))
-  io.window.restZero := (0 until k).map(j => j.U < offset || beatWords(j) === 0.U).reduce(_ && _)
-  io.window.beatLast := slotLast(slot)
+  io.window.restZero   := (0 until k).map(j => j.U < offset || beats.head._1(j) === 0.U).reduce(_ && _)
+  io.window.beatLast   := beats.head._2
 }
