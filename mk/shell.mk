@@ -12,10 +12,12 @@ SHELL_DIR      ?= build/shell/$(SHELL_ARCH)-m$(SHELL_M)-w$(SHELL_STREAM_BITS)
 SHELL_TESTBENCH := test/fusesoc/bpaccel_shell_smoke_tb.sv
 SHELL_VENV     := build/shell-venv/bin
 
-# SystemVerilog, bpaccel_params.h, bpaccel_shell.h, bpaccel_shell.rdl, registers.md and bpaccel_shell.core.
+# SystemVerilog, bpaccel_params.h, bpaccel_shell.h, bpaccel_shell.rdl, registers.md, bpaccel_shell.core,
+# and the registers as IP-XACT (bpaccel_shell_registers.xml, from the SystemRDL by PeakRDL).
 shell-verilog: deps
 	$(SBT) "runMain bpaccel.shell.EmitShell --arch $(SHELL_ARCH) --m $(SHELL_M) --capacity $(SHELL_CAPACITY) --stream-bits $(SHELL_STREAM_BITS) --dual-clock $(SHELL_DUAL_CLOCK) --target-dir $(SHELL_DIR) --smoke-testbench $(SHELL_TESTBENCH)"
 	cd $(SHELL_DIR) && verilator --lint-only -Wall lint_waivers.vlt -F filelist.f --top-module BpaccelShell
+	cd $(SHELL_DIR) && $(abspath $(SHELL_VENV))/peakrdl ip-xact bpaccel_shell.rdl -o bpaccel_shell_registers.xml
 	@echo "Shell for arch=$(SHELL_ARCH), m=$(SHELL_M), $(SHELL_STREAM_BITS)-bit streams: $(SHELL_DIR)/filelist.f"
 
 # docs/registers.md, from the default configuration's register map.

@@ -59,3 +59,10 @@ abstract class CoreAdapter(val p: ShellParams, val recordWords: Int) extends Mod
   val opcode: Protocol.Opcode
   val io = IO(new AdapterIO(p, recordWords))
 }
+
+object CoreAdapter {
+  /** The adapter of the configuration's core: the one place that knows which core answers which opcode. */
+  def apply(p: ShellParams): CoreAdapter = p.core.arch match {
+    case bpaccel.Arch.Seed | bpaccel.Arch.Stream => new CellsAdapter(p)
+  }
+}

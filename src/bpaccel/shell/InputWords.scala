@@ -60,13 +60,22 @@ class InputWords(p: ShellParams) extends Module {
 
   private val offset = readPtr(log2Ceil(k) - 1, 0)
   private val slot   = readPtr >> log2Ceil(k)
-  private val beats  = Seq.tabulate(reach)(b => (ring((slot + b.U)(log2Ceil(slots) - 1, 0)), slotLast((slot + b.U)(log2Ceil(slots) - 1, 0))))
+  // The multiplexers are AND-OR trees, word by word: written as multiplexers of Vecs, firtool
+  // folds them into multiplexers of arrays, which its lowering without packed arrays refuses.
+  private def select(choice: UInt, options: Seq[UInt]): UInt = {
+    val oneHot = UIntToOH(choice, options.length)
+    options.zipWithIndex.map { case (o, s) => Fill(o.getWidth, oneHot(s)) & o }.reduce(_ | _)
+  }
+  private val beats = Seq.tabulate(reach) { b =>
+    val at = (slot + b.U)(log2Ceil(slots) - 1, 0)
+    (Seq.tabulate(k)(j => select(at, ring.map(_(j)))), slotLast(at))
+  }
   private val words  = beats.flatMap(_._1)
   // Word w of the beats read ends its packet if it is its beat's last and that beat carried TLAST.
   private val lastAt = Seq.tabulate(words.length)(w => if (w % k == k - 1) beats(w / k)._2 else false.B)
   for (i <- 0 until p.itemWords) {
-    io.window.words(i) := VecInit.tabulate(k)(o => words(o + i))(offset)
-    io.window.last(i)  := VecInit.tabulate(k)(o => lastAt(o + i))(offset)
+    io.window.words(i) := select(offset, Seq.tabulate(k)(o => words(o + i)))
+    io.window.last(i)  := select(offset, Seq.tabulate(k)(o => lastAt(o + i))).asBool
   }
   io.window.count      := count
   io.window.restOfBeat := k.U - offset

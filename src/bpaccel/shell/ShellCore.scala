@@ -27,7 +27,7 @@ class ShellCore(p: ShellParams) extends Module {
     val abort = Input(Bool()) // a pulse: end the current command
   })
   val words   = Module(new InputWords(p))
-  val adapter = Module(new CellsAdapter(p))
+  val adapter = Module(CoreAdapter(p))
   val packer  = Module(new ReplyPacker(p, adapter.recordWords))
   words.io.in <> io.in
   io.out <> packer.io.out
