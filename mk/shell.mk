@@ -17,6 +17,7 @@ SHELL_VENV     := build/shell-venv/bin
 shell-verilog: deps
 	$(SBT) "runMain bpaccel.shell.EmitShell --arch $(SHELL_ARCH) --m $(SHELL_M) --capacity $(SHELL_CAPACITY) --stream-bits $(SHELL_STREAM_BITS) --dual-clock $(SHELL_DUAL_CLOCK) --target-dir $(SHELL_DIR) --smoke-testbench $(SHELL_TESTBENCH)"
 	cd $(SHELL_DIR) && verilator --lint-only -Wall lint_waivers.vlt -F filelist.f --top-module BpaccelShell
+	$(PYTHON) test/bpaccel/shell/comb_paths.py $(SHELL_DIR) BpaccelShell BroadPhaseAccel
 	cd $(SHELL_DIR) && $(abspath $(SHELL_VENV))/peakrdl ip-xact bpaccel_shell.rdl -o bpaccel_shell_registers.xml
 	@echo "Shell for arch=$(SHELL_ARCH), m=$(SHELL_M), $(SHELL_STREAM_BITS)-bit streams: $(SHELL_DIR)/filelist.f"
 

@@ -17,7 +17,7 @@ import chisel3.util._
   *
   * Every output port is a flip-flop or storage read behind flip-flops; no
   * input port reaches an output port through logic (checked by
-  * test/bpaccel/shell/CombinationalPathSpec on every configuration tested).
+  * test/bpaccel/shell/ShellSpec on every configuration it emits).
   */
 class BpaccelShell(val p: ShellParams) extends RawModule {
   override def desiredName = "BpaccelShell"

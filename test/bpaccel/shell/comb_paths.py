@@ -1,7 +1,11 @@
-"""Finds combinational paths from input ports to output ports of a flattened
-Yosys netlist (write_json after proc; flatten; memory -nomap; techmap).
+"""Finds combinational paths from input ports to output ports of an emitted design.
 
-Usage: comb_paths.py NETLIST.json TOP  -- prints each path's ports, exits 1 if any.
+Usage: comb_paths.py VERILOG_DIR TOP [BLACK_BOX ...]
+Yosys reads the files of VERILOG_DIR/filelist.f and flattens TOP to gates
+(proc; flatten; memory -nomap; techmap; write_json); modules named as black
+boxes count as logic from each of their inputs to each of their outputs,
+more paths than they have, so none found is still a proof. Prints each path
+found, exits 1 if any.
 
 Every cell is combinational from all its inputs to all its outputs except
 flip-flops and latches (state: a path ends there) and memories, whose
@@ -9,7 +13,9 @@ synchronous read ports and write ports break the path while an asynchronous
 read port passes its address to its data."""
 
 import json
+import subprocess
 import sys
+from pathlib import Path
 from collections import defaultdict
 
 SEQUENTIAL = ("$_DFF", "$_SDFF", "$_DFFE", "$_SDFFE", "$_SDFFCE", "$_ALDFF", "$_DFFSR", "$_DLATCH", "$_SR_",
@@ -65,9 +71,20 @@ def paths(netlist, top):
     return sorted(found)
 
 
+def netlist(verilog_dir: Path, top: str, black_boxes) -> dict:
+    files = [f for f in (verilog_dir / "filelist.f").read_text().split() if f.endswith(".sv")]
+    out = verilog_dir.resolve() / f"{top}.netlist.json"
+    boxes = "".join(f"blackbox {b}; " for b in black_boxes)
+    script = (f"read_verilog -sv {' '.join(files)}; {boxes}hierarchy -top {top}; proc; flatten; memory -nomap; "
+              f"opt_clean; techmap; opt_clean; write_json {out}")
+    subprocess.run(["yosys", "-q", "-p", script], cwd=verilog_dir, check=True)
+    with open(out) as f:
+        return json.load(f)
+
+
 if __name__ == "__main__":
-    with open(sys.argv[1]) as f:
-        found = paths(json.load(f), sys.argv[2])
+    top = sys.argv[2]
+    found = paths(netlist(Path(sys.argv[1]), top, sys.argv[3:]), top)
     for a, b in found:
         print(f"combinational path: {a} -> {b}")
     sys.exit(1 if found else 0)
