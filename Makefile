@@ -182,3 +182,6 @@ verilog: deps
 
 clean:
 	rm -rf target project/target generated build test_run_dir
+
+# The AXI shell's targets (shell-verilog, shell-registers, test-shell, shell-fusesoc, shell-synth).
+include mk/shell.mk

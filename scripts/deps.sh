@@ -12,6 +12,7 @@ debian_packages=(
   libtbb-dev                             # the host's thread pool
   clang libclang-rt-14-dev               # libFuzzer and the sanitizers
   ccache                                 # the specs' Verilator builds share its runtime objects
+  iverilog                               # the AXI shell's cocotb testbench and FuseSoC simulation
 )
 
 missing=()
@@ -55,6 +56,20 @@ fi
 # The host's code-size check (host/tests/layout/code_size.py, a ctest): lizard,
 # pinned, in a venv of its own.
 pip_venv "$build/host-tools" lizard 1.17.10 "./python -c 'import lizard'"
+
+# The AXI shell's Python tools (docs/integration.md), pinned, in a venv of their own:
+# cocotb and cocotbext-axi for its testbench, FuseSoC for its core file, PeakRDL to
+# check the SystemRDL its register map emits.
+shell_tools_version="cocotb==2.1.0 cocotbext-axi==0.1.28 fusesoc==2.4.7 peakrdl==1.5.0 peakrdl-cheader==1.1.0 peakrdl-regblock==1.3.1 pytest==9.2.0"
+shell_venv="$(cd "$here/.." && pwd)/build/shell-venv"
+if [ "$(cat "$shell_venv/tools-version" 2>/dev/null)" != "$shell_tools_version" ]; then
+  echo "deps: installing the shell's Python tools into $shell_venv" >&2
+  rm -rf "$shell_venv"
+  python3 -m venv "$shell_venv"
+  # shellcheck disable=SC2086
+  "$shell_venv/bin/python" -m pip install --quiet $shell_tools_version >&2
+  echo "$shell_tools_version" >"$shell_venv/tools-version"
+fi
 
 # The sbt launcher (scripts/sbt fetches it too; doing it here keeps `make deps` the one install step).
 "$here/sbt" --fetch-launcher
