@@ -8,7 +8,7 @@
 include(CMakePackageConfigHelpers)
 set(BPACCEL_VERSION 0.1.0)
 
-install(TARGETS bpaccel_core bpaccel_partition bpaccel_device bpaccel_broad_phase bpaccel_bullet
+install(TARGETS bpaccel_core bpaccel_partition bpaccel_query bpaccel_device bpaccel_broad_phase bpaccel_bullet
   EXPORT bpaccelTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   FILE_SET HEADERS DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bpaccel
