@@ -39,9 +39,9 @@ struct BroadPhaseManagerOptions {
 /// are checked with fcl::AABB::overlap in S before the callback sees them.
 ///
 /// Unlike FCL's managers: registering an object twice, or unregistering one
-/// that is not registered, throws std::invalid_argument; an AABB with NaN
-/// throws std::invalid_argument naming the object when it is read. update(obj)
-/// of an object not registered does nothing, as in FCL. collide and distance
+/// that is not registered, throws std::invalid_argument; an AABB with NaN or
+/// min above max throws std::invalid_argument naming the object when it is
+/// read. update(obj) of an object not registered does nothing, as in FCL. collide and distance
 /// keep scratch state: calls on one manager are serialised (a lock), and a
 /// callback must not call its own manager's collide or distance.
 template <typename S>

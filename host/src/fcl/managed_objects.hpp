@@ -44,7 +44,13 @@ class ManagedObjects {
   const std::vector<Object*>& objects() const { return objects_; }
   const std::vector<fcl::AABB<S>>& aabbs() const { return aabbs_; }
   const std::vector<Aabb>& boxes() const { return boxes_; }
-  QueryIndex& index() { return index_; }
+  /// The query tree over boxes(), brought up to date here: an update of
+  /// every object leaves it to the first collide(object) that needs it.
+  QueryIndex& index() {
+    if (indexStale_) index_.assign(boxes_);
+    indexStale_ = false;
+    return index_;
+  }
   /// Bumped by every change: what was found from the boxes before is stale.
   std::uint64_t version() const { return version_; }
 
@@ -73,23 +79,28 @@ class ManagedObjects {
       aabbs_[k] = aabbs_[last];
       boxes_[k] = boxes_[last];
       position_[objects_[k]] = k;
-      index_.set(k, boxes_[k]);
+      if (!indexStale_) index_.set(k, boxes_[k]);
     }
     objects_.pop_back();
     aabbs_.pop_back();
     boxes_.pop_back();
-    index_.erase(last);
+    if (!indexStale_) index_.erase(last);
     ++version_;
   }
 
-  /// `object`'s AABB; throws std::invalid_argument naming it and `where` when it has NaN.
+  /// `object`'s AABB; throws std::invalid_argument naming it and `where`
+  /// when it has NaN or a min above its max (an AABB never computed).
   static const fcl::AABB<S>& checkedAabb(const Object* object, const char* where) {
     const fcl::AABB<S>& aabb = object->getAABB();
-    for (int a = 0; a < 3; ++a)
-      if (std::isnan(aabb.min_[a]) || std::isnan(aabb.max_[a]))
-        throw std::invalid_argument(fmt::format("bpaccel::BroadPhaseManager: {}: object {} has NaN in its AABB on "
-                                                "axis {} (min {}, max {})",
-                                                where, fmt::ptr(object), a, aabb.min_[a], aabb.max_[a]));
+    for (int a = 0; a < 3; ++a) {
+      const char* fault = std::isnan(aabb.min_[a]) || std::isnan(aabb.max_[a]) ? "has NaN in its AABB"
+                          : aabb.min_[a] > aabb.max_[a]                       ? "has its AABB's min above its max"
+                                                                              : nullptr;
+      if (fault != nullptr)
+        throw std::invalid_argument(fmt::format("bpaccel::BroadPhaseManager: {}: object {} {} on axis {} (min {}, "
+                                                "max {})",
+                                                where, fmt::ptr(object), fault, a, aabb.min_[a], aabb.max_[a]));
+    }
     return aabb;
   }
 
@@ -98,7 +109,7 @@ class ManagedObjects {
     const fcl::AABB<S>& aabb = checkedAabb(objects_[k], "reading a registered object");
     aabbs_[k] = aabb;
     boxes_[k] = outwardBox(aabb);
-    index_.set(static_cast<std::uint32_t>(k), boxes_[k]);
+    if (!indexStale_) index_.set(static_cast<std::uint32_t>(k), boxes_[k]);
     ++version_;
   }
 
@@ -114,7 +125,7 @@ class ManagedObjects {
       aabbs_[k] = objects_[k]->getAABB();
       boxes_[k] = outwardBox(aabbs_[k]);
     }
-    index_.assign(boxes_);
+    indexStale_ = true;
     ++version_;
   }
 
@@ -124,6 +135,7 @@ class ManagedObjects {
     boxes_.clear();
     position_.clear();
     index_.clear();
+    indexStale_ = false;
     ++version_;
   }
 
@@ -133,6 +145,7 @@ class ManagedObjects {
   std::vector<fcl::AABB<S>> aabbs_;
   std::vector<Aabb> boxes_;
   QueryIndex index_;  // boxes_ by position, for collide(object)
+  bool indexStale_ = false;  // index_ is to be assigned boxes_ before its next use
   std::uint64_t version_ = 0;
 };
 

@@ -2,7 +2,9 @@
 // The overlapping pairs of a set of float boxes through BroadPhase: all of
 // them, or only those across two groups.
 
+#include <cmath>
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -28,7 +30,21 @@ class PairFinder {
 };
 
 /// The largest float at or below `v`, and the smallest at or above it (±infinity beyond float's range; NaN stays NaN).
-float floatAtOrBelow(double v);
-float floatAtOrAbove(double v);
+/// Inline: every object's six bounds go through them at each update.
+inline float floatAtOrBelow(double v) {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  if (v > kMax) return std::numeric_limits<float>::max();
+  if (v < -kMax) return -std::numeric_limits<float>::infinity();
+  const float f = static_cast<float>(v);
+  return static_cast<double>(f) > v ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+}
+
+inline float floatAtOrAbove(double v) {
+  constexpr double kMax = std::numeric_limits<float>::max();
+  if (v < -kMax) return -std::numeric_limits<float>::max();
+  if (v > kMax) return std::numeric_limits<float>::infinity();
+  const float f = static_cast<float>(v);
+  return static_cast<double>(f) < v ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
 
 }  // namespace bpaccel

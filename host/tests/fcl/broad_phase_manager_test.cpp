@@ -146,6 +146,12 @@ TYPED_TEST(BroadPhaseManagerTest, SamePairsAsFclTreeAfterEveryKindOfUpdate) {
       EXPECT_FALSE(got.duplicate) << "n=" << n << " round " << round;
       ASSERT_EQ(got.pairs, want.pairs) << "n=" << n << " round " << round;
       if (n == 1500) EXPECT_GT(want.pairs.size(), 300u);
+      for (std::size_t q = 0; q < std::min<std::size_t>(n, 20); ++q) {  // the query tree after each update
+        Recorder<S> wantQ, gotQ;
+        theirs.collide(env[q].get(), &wantQ, recordOrdered<S>);
+        mine.collide(env[q].get(), &gotQ, recordOrdered<S>);
+        ASSERT_EQ(gotQ.pairs, wantQ.pairs) << "n=" << n << " round " << round << " query " << q;
+      }
       jiggle(env, S(3), static_cast<unsigned>(round));
       switch (round) {  // all objects at once, one by one, as a list
         case 0: theirs.update(); mine.update(); break;
@@ -296,7 +302,11 @@ TYPED_TEST(BroadPhaseManagerTest, RegistryKeepsFclsBookkeeping) {
   bpaccel::BroadPhaseManager<S> mine;
   EXPECT_TRUE(mine.empty());
   mine.registerObjects(raw(env));
+  mine.update();  // leaves the query tree to be rebuilt: the removal must reach it too
   mine.unregisterObject(env[3].get());
+  Recorder<S> near3;
+  mine.collide(env[3].get(), &near3, recordOrdered<S>);
+  EXPECT_EQ(near3.pairs.count({env[3].get(), env[3].get()}), 0u) << "an unregistered object still reported";
   std::vector<Object<S>*> objects;
   mine.getObjects(objects);
   EXPECT_EQ(objects.size(), 9u);
@@ -325,6 +335,27 @@ TYPED_TEST(BroadPhaseManagerTest, RefusesAnAabbWithNanNamingTheObject) {
   }
   EXPECT_THROW(mine.collide(env[2].get(), nullptr, record<S>), std::invalid_argument);
   EXPECT_EQ(mine.size(), 4u);
+}
+
+// An object whose AABB was never computed (FCL's empty AABB, min above max).
+template <typename S>
+struct UncomputedObject : Object<S> {
+  explicit UncomputedObject(std::shared_ptr<fcl::CollisionGeometry<S>> shape) : Object<S>(shape) {
+    this->aabb = fcl::AABB<S>();
+  }
+};
+
+TYPED_TEST(BroadPhaseManagerTest, RefusesAnAabbWithMinAboveMaxBeforeRegistering) {
+  using S = TypeParam;
+  UncomputedObject<S> empty(std::make_shared<fcl::Sphere<S>>(1));
+  bpaccel::BroadPhaseManager<S> mine;
+  try {
+    mine.registerObject(&empty);
+    FAIL() << "an inverted AABB accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("min above its max on axis 0"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(mine.empty());
 }
 
 // Any backend: the cycle-exact model of the device gives the same pairs.
