@@ -1,6 +1,6 @@
 // ManyWorlds: every world's pairs equal brute force on that world alone, on
-// the cpu backend and on modelled devices (small capacity, narrow keys), for
-// many world counts and sizes; worlds are batched as cells; a bad box names
+// the cpu backend, on modelled devices (small capacity, narrow keys) and on
+// the Verilated device, for many world counts and sizes; worlds are batched as cells; a bad box names
 // its world; a backend that loses pairs is caught.
 
 #include <gtest/gtest.h>
@@ -16,6 +16,7 @@
 #include "broad_phase/many_worlds.hpp"
 #include "device/cpu_backend.hpp"
 #include "device/model_backend.hpp"
+#include "device/rtl/rtl_backend.hpp"
 #include "dropping_backend.hpp"
 #include "scenes.hpp"
 
@@ -85,6 +86,13 @@ TEST(ManyWorlds, BatchesTheWorldsAsCellsOfOneHandOver) {
   EXPECT_EQ(many.stats().runs, withPairsToTest);
   EXPECT_LT(many.stats().batches, many.stats().runs);
   EXPECT_GT(out.pairs().size(), 200u);
+}
+
+// The Verilated hardware: each world one cell of its batches.
+TEST(ManyWorlds, EveryWorldsPairsAreBruteForceOnTheVerilatedDevice) {
+  RtlBackend rtl;
+  const auto worlds = randomWorlds(40, 24, 6);
+  EXPECT_EQ(firstWrongWorld(rtl, worlds), -1);
 }
 
 TEST(ManyWorlds, NamesTheWorldAndBoxOfABadBox) {
