@@ -41,6 +41,8 @@ import sys
 import time
 from pathlib import Path
 
+from fpgaflow.names import params_name
+
 REPO = Path(__file__).resolve().parents[2]
 
 TOP = "BroadPhaseAccel"
@@ -403,8 +405,8 @@ def wrapper_only_cells(runner, yosys: str, work: Path) -> dict:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--verilog-dir", required=True, type=Path, help="directory holding filelist.f")
-    ap.add_argument("--m", required=True, type=int, help="parallelism the Verilog was emitted for")
-    ap.add_argument("--out", type=Path, help="JSON report (default results/fpga/m<M>.json)")
+    ap.add_argument("--m", type=int, help="parallelism the Verilog was emitted for (checked against its bpaccel_params.json)")
+    ap.add_argument("--out", type=Path, help="JSON report (default results/fpga/<name>.json, scripts/fpga/fpgaflow/names.py)")
     ap.add_argument("--venv", type=Path, default=REPO / ".venv", help="virtual env for the yowasp tools")
     ap.add_argument("--clock-mhz", type=float, default=200.0, help="clock constraint given to nextpnr")
     ap.add_argument("--work-dir", type=Path, help="scratch dir (default: work/<name of --out without .json> beside --out)")
@@ -435,11 +437,10 @@ def flow(args) -> int:
     t_start = time.monotonic()
     deadline = t_start + args.timeout if args.timeout else None
     revision = source_revision()  # at the start: commits made while nextpnr runs are not what it measures
-    m = args.m
-    if m < 1:
-        raise FlowError(EXIT_INPUT, "--m must be >= 1")
     vdir = args.verilog_dir.resolve()
-    out = (args.out or REPO / "results" / "fpga" / f"m{m}.json").resolve()
+    params = read_params(vdir, args.m)
+    m = params["m"]
+    out = (args.out or REPO / "results" / "fpga" / f"{params_name(params)}.json").resolve()
     work = (args.work_dir or out.parent / "work" / out.stem).resolve()
     # Never leave a stale report behind that a failed run could be mistaken for.
     if out.exists():
@@ -454,15 +455,13 @@ def flow(args) -> int:
     mods = module_names(work, files)
     if TOP not in mods:
         raise FlowError(EXIT_INPUT, f"no module {TOP} in {vdir}/filelist.f")
-    mem_modules = [n for n in mods if n.startswith("mem_")]
-    params = parse_params(vdir)
-    capacity = params.get("capacity")
+    mem_modules = [params["memory_module"]] if params["memory_style"] == "inferred" else []
+    capacity = params["capacity"]
     ecp5_files, registered = ecp5_registered_memories(work, files)
-    memory_style = "ecp5-outreg" if registered else "inferred"
-    if params.get("memory_style", memory_style) != memory_style:
-        raise FlowError(EXIT_INPUT, f"bpaccel_params.h says memory style {params['memory_style']}, "
+    memory_style = params["memory_style"]
+    if ("ecp5-outreg" if registered else "inferred") != memory_style:
+        raise FlowError(EXIT_INPUT, f"bpaccel_params.json says memory style {memory_style}, "
                                     f"but the Verilog has {'' if registered else 'no '}RegisteredReadMemory modules")
-    params["memory_style"] = memory_style
 
     t0 = time.monotonic()
     bins = ensure_venv(args.venv.resolve())
@@ -501,8 +500,8 @@ def flow(args) -> int:
 
     # ---- did the memories become block RAM?
     # seed: 6m striped memories; stream: one memory of six keys a row.
-    arch = params.get("arch", "seed")
-    n_mems = 1 if arch == "stream" else 6 * m
+    arch = params["arch"]
+    n_mems = params["memory_count"]
     dp16 = ecp5_cells.get("DP16KD", 0)
     if registered:
         # Instantiated, not inferred: every one of the n_mems memories is a RegisteredReadMemory.
@@ -681,8 +680,9 @@ def critical_path(rep: dict, clk_net: str) -> dict | None:
 
 
 def update_breakdown(args) -> int:
-    m = args.m
-    out = (args.out or REPO / "results" / "fpga" / f"m{m}.json").resolve()
+    params = read_params(args.verilog_dir.resolve(), args.m)
+    m = params["m"]
+    out = (args.out or REPO / "results" / "fpga" / f"{params_name(params)}.json").resolve()
     if not out.is_file():
         raise FlowError(EXIT_INPUT, f"{out} not found: run the full flow first")
     rep = json.loads(out.read_text())
@@ -695,7 +695,7 @@ def update_breakdown(args) -> int:
     for f in files:
         shutil.copy2(vdir / f, work / f)
     mods = module_names(work, files)
-    mem_modules = [n for n in mods if n.startswith("mem_")]
+    mem_modules = [params["memory_module"]] if params["memory_style"] == "inferred" else []
     bins = ensure_venv(args.venv.resolve())
     runner = Runner(work, time.monotonic() + args.timeout if args.timeout else None)
     yosys = str(bins["yosys"])
@@ -734,24 +734,15 @@ def blackbox_stub(ports) -> str:
     return f"(* blackbox *)\nmodule {TOP} (\n" + ",\n".join(decl) + "\n);\nendmodule\n"
 
 
-def parse_params(vdir: Path) -> dict:
-    """arch / m / capacity / key width from bpaccel_params.h when present."""
-    h = vdir / "bpaccel_params.h"
-    out = {}
-    if h.is_file():
-        text = h.read_text()
-        for key, macro in (("m", "BPACCEL_M"), ("capacity", "BPACCEL_CAPACITY"),
-                           ("key_width", "BPACCEL_KEY_WIDTH")):
-            mm = re.search(rf"^#define\s+{macro}\s+(\d+)", text, re.M)
-            if mm:
-                out[key] = int(mm.group(1))
-        mm = re.search(r'^#define\s+BPACCEL_ARCH\s+"(\w+)"', text, re.M)
-        out["arch"] = mm.group(1) if mm else "seed"  # headers from before the stream architecture
-        fp = re.search(r'^#define\s+BPACCEL_FINGERPRINT\s+"([^"]*)"', text, re.M)
-        if fp:  # the fingerprint names the memory style only when it is not the default
-            ms = re.search(r"(?:^|,)memory=([\w-]+)", fp.group(1))
-            out["memory_style"] = ms.group(1) if ms else "inferred"
-    return out
+def read_params(vdir: Path, m: int | None = None) -> dict:
+    """The generator's parameter file beside the Verilog (bpaccel_params.json); `m`, when given, must agree."""
+    path = vdir / "bpaccel_params.json"
+    if not path.is_file():
+        raise FlowError(EXIT_INPUT, f"{path} not found (emit the design with: make verilog VERILOG_DIR={vdir})")
+    params = json.loads(path.read_text())
+    if m is not None and params["m"] != m:
+        raise FlowError(EXIT_INPUT, f"--m {m} but {path} says m = {params['m']}")
+    return params
 
 
 GENERATOR_SOURCES = ["src", "build.sbt"]
@@ -773,15 +764,13 @@ def source_revision() -> str | None:
 
 
 def base_report(m, capacity, params, args, versions, wrapper_info, revision: str | None = None) -> dict:
-    if params.get("m") is not None and params["m"] != m:
-        raise FlowError(EXIT_INPUT, f"--m {m} but {args.verilog_dir}/bpaccel_params.h says m = {params['m']}")
     return {
         "schema": "bpaccel-fpga-1",
-        "arch": params.get("arch", "seed"),
-        "memory_style": params.get("memory_style", "inferred"),
+        "arch": params["arch"],
+        "memory_style": params["memory_style"],
         "m": m,
         "capacity": capacity,
-        "key_width": params.get("key_width"),
+        "key_width": params["key_width"],
         "date": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "source_revision": revision,
         "host": {"machine": platform.machine(), "cpus": os.cpu_count()},

@@ -27,6 +27,7 @@ import chisel3.util._
   * duplicated.
   */
 class BroadPhaseAccel(val p: AccelParams) extends Module {
+  override def desiredName: String = BroadPhaseAccel.topName
   val io = IO(new Bundle {
     val load     = Flipped(Decoupled(new Aabb(p.keyWidth)))
     val start    = Flipped(Decoupled(new RunRequest(p)))
@@ -41,10 +42,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   val loader  = Module(new Loader(p))
   val control = Module(new RunControl(p))
   val batch   = Module(new BatchControl(p))
-  val engine = p.arch match {
-    case Arch.Seed   => Module(new SeedEngine(p))
-    case Arch.Stream => Module(new StreamEngine(p))
-  }
+  val engine  = Module(p.arch.engine(p))
   // A beat that meets an empty queue and a ready consumer passes in the same cycle.
   val queue = Module(new Queue(new ResultBeat(p), p.resultQueueDepth, flow = true))
 
@@ -137,7 +135,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   io.info.capacity          := p.capacity.U
   io.info.keyWidth          := p.keyWidth.U
   io.info.runOverheadCycles := p.runOverheadCycles.U
-  io.info.readLatency       := (if (p.arch == Arch.Stream) p.readLatency else 0).U
+  io.info.readLatency       := p.startupLatency.U
   io.info.batchCells        := p.batchCells.U
   io.info.cellTagWidth      := p.cellTagWidth.U
   io.info.batchOverlapsLoads := p.overlapsLoads.B
@@ -150,6 +148,9 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
 }
 
 object BroadPhaseAccel {
+  /** The top module's name in the emitted Verilog. */
+  val topName = "BroadPhaseAccel"
+
   /** The message of the design's own check that credits never let a beat meet a full result queue. */
   val ResultQueueOverflow = "result queue overflow: credit accounting is broken"
 }

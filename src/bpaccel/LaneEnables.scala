@@ -39,7 +39,7 @@ object LaneEnables {
     } yield s"${reg}_${k}_box"
 
   /** Throws naming the first wrong lane, for a stream configuration's emitted folder. */
-  def check(p: AccelParams, dir: Path): Unit = if (p.arch == Arch.Stream) {
+  def check(p: AccelParams, dir: Path): Unit = {
     val file = "StreamEngine.sv"
     val text = Files.readString(dir.resolve(file))
     for ((reg, copy) <- mismatches(text).headOption)

@@ -61,7 +61,7 @@ class ResultSpec extends AnyFlatSpec with Simulators with Checks {
 
   for (stages <- Seq(0, 1, 3))
     it should s"report exactly the brute-force pairs with $stages memory output stages (m=3)" in {
-      val p = AccelParams(m = 3, capacity = 24, memoryOutputStages = stages)
+      val p = AccelParams(m = 3, capacity = 24, memoryOutputStages = stages, arch = Arch.Seed)
       onVerilator(p) { dut =>
         val drv = new AccelDriver(dut)
         drv.idleInputs()
@@ -74,7 +74,7 @@ class ResultSpec extends AnyFlatSpec with Simulators with Checks {
     }
 
   it should "work with narrow keys (8 bits) at the ends of their range" in {
-    val p = AccelParams(m = 4, capacity = 32, keyWidth = 8)
+    val p = AccelParams(m = 4, capacity = 32, keyWidth = 8, arch = Arch.Seed)
     onVerilator(p) { dut =>
       val drv = new AccelDriver(dut)
       drv.idleInputs()

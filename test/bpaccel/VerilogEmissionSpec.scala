@@ -12,7 +12,7 @@ import scala.sys.process._
 class VerilogEmissionSpec extends AnyFlatSpec with Matchers {
 
   private def emitted(m: Int, arch: Arch = Arch.Seed, capacity: Option[Int] = None): (AccelParams, Path) = {
-    val p   = AccelParams(m = m, capacity = capacity.getOrElse(AccelParams.defaultCapacity(m)), arch = arch)
+    val p   = AccelParams(m = m, capacity = capacity.getOrElse(arch.defaultCapacity(m)), arch = arch)
     val dir = Files.createTempDirectory(s"bpaccel-${arch.name}-m$m-")
     EmitVerilog.emit(p, dir)
     (p, dir)
