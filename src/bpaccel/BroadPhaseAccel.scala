@@ -130,16 +130,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   io.status.cellsDone := batch.io.cellsDone
   io.counters := control.io.counters
 
-  io.info.arch              := p.arch.id.U
-  io.info.m                 := p.m.U
-  io.info.capacity          := p.capacity.U
-  io.info.keyWidth          := p.keyWidth.U
-  io.info.runOverheadCycles := p.runOverheadCycles.U
-  io.info.readLatency       := p.startupLatency.U
-  io.info.batchCells        := p.batchCells.U
-  io.info.cellTagWidth      := p.cellTagWidth.U
-  io.info.batchOverlapsLoads := p.overlapsLoads.B
-  io.info.bipartiteRuns      := p.bipartiteRuns.B
+  io.info := AccelInfo(p)
 
   io.debug.foreach(_ := engine.io.probe.get)
 

@@ -1,6 +1,7 @@
 package bpaccel
 
 import chisel3._
+import chisel3.experimental.BundleLiterals._
 import chisel3.util._
 
 /** One axis-aligned bounding box as six order-preserving keys. */
@@ -109,6 +110,22 @@ class AccelInfo extends Bundle {
   val cellTagWidth      = UInt(8.W)  // bits of a result beat's cell tag
   val batchOverlapsLoads = Bool()    // a batch loads its next cell while one runs
   val bipartiteRuns     = Bool()     // starts and cells may carry a split (RunRequest)
+}
+
+object AccelInfo {
+  /** The info port's constants: the parameters the C header carries too. */
+  def apply(p: AccelParams): AccelInfo = (new AccelInfo).Lit(
+    _.arch               -> p.arch.id.U,
+    _.m                  -> p.m.U,
+    _.capacity           -> p.capacity.U,
+    _.keyWidth           -> p.keyWidth.U,
+    _.runOverheadCycles  -> p.runOverheadCycles.U,
+    _.readLatency        -> p.startupLatency.U,
+    _.batchCells         -> p.batchCells.U,
+    _.cellTagWidth       -> p.cellTagWidth.U,
+    _.batchOverlapsLoads -> p.overlapsLoads.B,
+    _.bipartiteRuns      -> p.bipartiteRuns.B
+  )
 }
 
 /** The ports every architecture's engine offers the shared top level. */
