@@ -83,11 +83,11 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
     }
 
   private val configurations = Seq(
-    AccelParams(m = 1, capacity = 12, batchCells = 8, arch = Arch.Seed),
-    AccelParams(m = 3, capacity = 24, batchCells = 8, arch = Arch.Seed), // not a power of two
-    AccelParams(m = 8, capacity = 64, batchCells = 16, arch = Arch.Seed),
-    AccelParams(m = 3, capacity = 25, arch = Arch.Stream, batchCells = 8),
-    AccelParams(m = 8, capacity = 64, arch = Arch.Stream, batchCells = 4),
+    SharedConfigs.seedM1,
+    SharedConfigs.seedM3,
+    SharedConfigs.seedM8,
+    SharedConfigs.streamM3,
+    SharedConfigs.streamM8,
     AccelParams(m = 2, capacity = 10, arch = Arch.Stream, batchCells = 1), // the head register is the whole queue
     // Loads and runs overlap in a batch: the block RAM's read and write ports must never collide.
     AccelParams(m = 3, capacity = 24, batchCells = 8, memoryStyle = MemoryStyle.Ecp5OutputRegister, arch = Arch.Seed),

@@ -8,10 +8,7 @@ import scala.util.Random
 
 /** Errors instead of silent truncation, and recovery after runs and resets, for both architectures. */
 class ProtocolSpec extends AnyFlatSpec with Simulators with Checks {
-  private val configurations = Seq(
-    AccelParams(m = 4, capacity = 16, arch = Arch.Seed),
-    AccelParams(m = 4, capacity = 18, arch = Arch.Stream) // the stream needs no multiple of m
-  )
+  private val configurations = Seq(SharedConfigs.seedM3, SharedConfigs.streamM3)
 
   for (p <- configurations) {
     val arch = s"(${p.arch.name})"
