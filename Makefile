@@ -40,6 +40,8 @@ HOST_BUILD   := build/host-$(DESIGN_NAME)
 # A device of narrower keys gets its own too (build/bin-k16).
 HOST_BIN_DIR ?= build/bin$(KEY_SUFFIX)
 SCALA_SOURCES := $(wildcard src/bpaccel/*.scala) build.sbt
+# Non-empty when one of the files $(1) is missing or older than a Scala source.
+stale = $(strip $(foreach f,$(1),$(if $(wildcard $(f)),$(shell find $(SCALA_SOURCES) -newer $(f) | head -1),missing)))
 # Extra options for `bpaccel bench` (see `build/bin/bpaccel bench --help`).
 BENCH_ARGS ?=
 
@@ -55,22 +57,28 @@ all: test
 deps:
 	@./scripts/deps.sh
 
-# Every test of the project.
-test: deps test-hw test-host test-fpga test-fuzz
+# Every test of the project, part by part; the last line gives each part's
+# time against the 10-minute budget (scripts/test_parts.sh).
+test: deps
+	@MAKE="$(MAKE)" scripts/test_parts.sh sbt=test-hw host=test-host fpga=test-fpga fuzz=test-fuzz
 
 # The Chisel generator: golden model, ChiselTest (Scala simulator and Verilator),
-# Verilog lint and memory structure.
+# Verilog lint and memory structure. The same sbt session then emits the
+# Verilog the host and the FPGA flow's test build, where it is out of date,
+# which spares each an sbt start-up.
 test-hw: deps
-	$(SBT) test
+	$(SBT) test $(if $(call stale,$(HOST_VERILOG)/filelist.f),$(EMIT_HOST)) \
+	  $(if $(call stale,$(FPGA_TEST_VERILOG)/filelist.f $(FPGA_TEST_STREAM_VERILOG)/filelist.f),$(EMIT_FPGA_TEST))
 
 # The formal checks at depths that cover a whole run of each small
 # configuration (docs/verification.md); `make test` runs shallower ones.
 formal-long: deps
-	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec"
+	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec bpaccel.FormalMutantSpec"
 
 # The C++ host (build/bin/bpaccel) with the Verilated accelerator, and its tests.
+EMIT_HOST = "runMain bpaccel.EmitVerilog $(EMIT_ARGS) --target-dir $(HOST_VERILOG)"
 $(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
-	$(SBT) "runMain bpaccel.EmitVerilog $(EMIT_ARGS) --target-dir $(HOST_VERILOG)"
+	$(SBT) $(EMIT_HOST)
 
 host: deps $(HOST_VERILOG)/filelist.f
 	cmake -S host -B $(HOST_BUILD) -G Ninja -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BIN_DIR=$(abspath $(HOST_BIN_DIR))
@@ -136,7 +144,10 @@ print-other-arch:
 # libFuzzer targets on the box-file parser and the pair-finding API
 # (host/fuzz/README.md), built with clang, ASan and UBSan; no Verilator needed.
 FUZZ_BUILD   := build/fuzz
-FUZZ_SECONDS ?= 60
+# make test replays each target's committed corpus and searches on for
+# FUZZ_SECONDS (20 s: about 120,000 box-file and 24,000 pairs inputs);
+# fuzz-long is the deep search.
+FUZZ_SECONDS ?= 20
 FUZZ_RUNS    ?= 1000000
 fuzz: deps
 	cmake -S host/fuzz -B $(FUZZ_BUILD) -G Ninja -DCMAKE_CXX_COMPILER=clang++
@@ -160,9 +171,10 @@ fpga-sweep: deps
 	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --key-width $(KEY_WIDTH) $(if $(CAPACITY),--capacity $(CAPACITY)) $(if $(FPGA_MEMORY_STYLE),--memory-style $(FPGA_MEMORY_STYLE)) --verilog-root build/fpga-verilog --emit always --budget-min 60
 
 # Both architectures at m = 2 (the stream with a small memory, so the flow stays quick), emitted by one sbt run.
+EMIT_FPGA_TEST = "runMain bpaccel.EmitVerilog --arch seed --m 2 --target-dir $(FPGA_TEST_VERILOG)" \
+                 "runMain bpaccel.EmitVerilog --arch stream --m 2 --capacity 512 --target-dir $(FPGA_TEST_STREAM_VERILOG)"
 $(FPGA_TEST_VERILOG)/filelist.f $(FPGA_TEST_STREAM_VERILOG)/filelist.f &: $(SCALA_SOURCES) | deps
-	$(SBT) "runMain bpaccel.EmitVerilog --arch seed --m 2 --target-dir $(FPGA_TEST_VERILOG)" \
-	       "runMain bpaccel.EmitVerilog --arch stream --m 2 --capacity 512 --target-dir $(FPGA_TEST_STREAM_VERILOG)"
+	$(SBT) $(EMIT_FPGA_TEST)
 # Options for flow.py, e.g. FPGA_ARGS="--router router2 --threads 2".
 FPGA_ARGS ?=
 
