@@ -15,13 +15,18 @@ import chisel3.util.log2Ceil
 sealed abstract class MemoryStyle(val name: String) {
   /** The module of one coordinate memory in the emitted Verilog. */
   def moduleName(rows: Int, width: Int): String
+
+  /** Cycles from a read's row to its data (see [[CoordinateMemory]]). */
+  def readLatency: Int
 }
 object MemoryStyle {
   case object Inferred extends MemoryStyle("inferred") {
     def moduleName(rows: Int, width: Int): String = s"mem_${rows}x$width" // firtool's name for a SyncReadMem
+    def readLatency = 1
   }
   case object Ecp5OutputRegister extends MemoryStyle("ecp5-outreg") {
     def moduleName(rows: Int, width: Int): String = s"${RegisteredReadMemory.namePrefix}${rows}x$width"
+    def readLatency: Int = RegisteredReadMemory.readLatency
   }
   val all: Seq[MemoryStyle] = Seq(Inferred, Ecp5OutputRegister)
   def fromName(name: String): MemoryStyle =

@@ -63,9 +63,9 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   val clear = start.fire || (if (p.overlapsLoads) batch.io.take.valid else batch.io.begin)
 
   // A start or a batch's first count in the same cycle wins, so a box is never loaded into the next run by accident.
-  // `offered` is the same without that term, for the engine's look-aheads:
-  // the host's start and count reached the head chain's enable copies
-  // through the load port's ready (stream m = 64's critical path, 78.8 MHz).
+  // `offered` is the same without that term, for the engine's look-aheads,
+  // so that the host's start and count do not reach the head chain's enable
+  // copies through the load port's ready.
   val loadOpen = Mux(batch.io.active, batch.io.loadReady, !control.io.status.busy)
   io.load.ready := loadOpen && (batch.io.active || !io.start.valid && !io.cells.valid)
   loader.io.offered    := io.load.valid && loadOpen
@@ -90,9 +90,9 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   engine.io.headPad       := loader.io.headPad
   engine.io.launch  := control.io.launch
   // Credits: result-queue entries neither occupied nor claimed by a cycle in
-  // flight. They are kept in a register, because the check computed from the
-  // queue's pointers (count + in flight + 1 < depth) sat in front of the
-  // engine's enable look-ahead (stream m = 32's critical path, 98.1 MHz).
+  // flight, kept in a register so that no compare of the queue's pointers
+  // (count + in flight + 1 < depth) sits in front of the engine's enable
+  // look-ahead.
   // Occupied + claimed grows by at most one a cycle, so two credits now mean
   // room for one more issue in the next cycle.
   val credits = RegInit(creditedEntries.U(log2Ceil(creditedEntries + 1).W))
@@ -115,10 +115,10 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   io.result <> queue.io.deq
   if (p.has(Fault.DropBeatWhenNotReady)) queue.io.deq.ready := true.B
 
-  // The popcount gets its own register: at m = 32 popcount + 64-bit add was
-  // the critical path (80.7 MHz). The engine counts groups of lanes beside
-  // the mask, so only their sum is left here. The count still lands by the
-  // time done rises, which is at least one cycle after the last beat was queued.
+  // The popcount gets its own register, apart from the 64-bit add, and the
+  // engine counts groups of lanes beside the mask, so only their sum is
+  // left here. The count still lands by the time done rises, which is at
+  // least one cycle after the last beat was queued.
   control.io.queuedHits := Pipe(queue.io.enq.fire, Engine.sumHitCounts(p.m, engine.io.outHitCounts))
   control.io.queueEmpty       := queue.io.count === 0.U
 

@@ -177,14 +177,14 @@ class VerilogEmissionSpec extends AnyFlatSpec with Matchers {
   for (m <- Seq(3, 16))
     it should s"put every lane register of the stream engine under its own lane's enable copies, m=$m" in {
       val (p, dir) = emitted(m, Arch.Stream, capacity = Some(24 * m))
-      val text     = read(dir, "StreamEngine.sv")
+      val text     = read(dir, LaneEnables.file)
       LaneEnables.mismatches(text) shouldBe empty
       LaneEnables.unguarded(text, m) shouldBe empty
       // What the miscompile looked like: lane 2's copy from the head chain under lane 1's head shift.
       val broken = text.replaceFirst("if \\(windowWrite_replica2\\)(\\s+window_2_box <=)", "if (headShift_replica1)$1")
       broken should not equal text
       LaneEnables.mismatches(broken) shouldBe Seq("window_2_box <=" -> "headShift_replica1")
-      Files.writeString(dir.resolve("StreamEngine.sv"), broken)
+      Files.writeString(dir.resolve(LaneEnables.file), broken)
       val e = the[IllegalStateException] thrownBy LaneEnables.check(p, dir)
       e.getMessage should include("assigns 'window_2_box <=' under 'headShift_replica1', another lane's enable")
       // A lane whose enables were dropped altogether.
