@@ -6,6 +6,7 @@ import org.scalatest.flatspec.AnyFlatSpec
 import org.scalatest.matchers.should.Matchers
 
 import scala.jdk.CollectionConverters._
+import scala.util.matching.Regex
 import scala.sys.process._
 
 /** What FPGA flows get: lint-clean SystemVerilog whose buffers are memories. */
@@ -99,7 +100,7 @@ class VerilogEmissionSpec extends AnyFlatSpec with Matchers {
       memories should not be empty
       for (f <- memories)
         withClue(s"$f: ") {
-          "(?m)^\\s*\\(\\* no_rw_check \\*\\) reg \\[[^\\]]+\\] Memory\\[".r.findAllIn(read(dir, f)).length shouldBe 1
+          s"(?m)^\\s*${Regex.quote(NoCollisionMemories.attribute)} reg \\[[^\\]]+\\] Memory\\[".r.findAllIn(read(dir, f)).length shouldBe 1
         }
     }
 
