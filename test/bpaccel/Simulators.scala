@@ -5,7 +5,7 @@ import java.util.concurrent.{ConcurrentHashMap, Semaphore}
 import chisel3.Module
 import chiseltest._
 import chiseltest.internal.CachingAnnotation
-import chiseltest.simulator.{VerilatorBackendAnnotation, VerilatorCFlags}
+import chiseltest.simulator.VerilatorBackendAnnotation
 import firrtl2.options.TargetDirAnnotation
 import org.scalatest.TestSuite
 
@@ -49,12 +49,7 @@ trait Simulators extends ChiselScalatestTester { this: TestSuite =>
   * all tests of the design run side by side on copies of the same library.
   */
 object VerilatorModels {
-  /** ChiselTest compiles models with -O1; the specs' runs are short, and
-    * -O0 builds a model in about a third of the time (3 configurations at
-    * m = 8: 8 s against 34 s) for no measurable loss in their run time.
-    */
-  def annotations(dir: String) =
-    Seq(VerilatorBackendAnnotation, VerilatorCFlags(Seq("-O0")), CachingAnnotation, TargetDirAnnotation(dir))
+  def annotations(dir: String) = Seq(VerilatorBackendAnnotation, CachingAnnotation, TargetDirAnnotation(dir))
 
   private final class Model {
     val firstUse        = new Semaphore(1)
