@@ -42,7 +42,7 @@ HOST_BIN_DIR ?= build/bin$(KEY_SUFFIX)
 SCALA_SOURCES := $(wildcard src/bpaccel/*.scala) build.sbt
 # Non-empty when one of the files $(1) is missing or older than a Scala source.
 stale = $(strip $(foreach f,$(1),$(if $(wildcard $(f)),$(shell find $(SCALA_SOURCES) -newer $(f) | head -1),missing)))
-# Extra options for `bpaccel bench` (see `build/bin/bpaccel bench --help`).
+# Extra options for `bpaccel-bench run` (see `build/bin/bpaccel-bench run --help`).
 BENCH_ARGS ?=
 
 # The FPGA flow's own test runs on this configuration.
@@ -75,7 +75,7 @@ test-hw: deps
 formal-long: deps
 	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec bpaccel.FormalMutantSpec"
 
-# The C++ host (build/bin/bpaccel) with the Verilated accelerator, and its tests.
+# The C++ host (build/bin/bpaccel, build/bin/bpaccel-bench) with the Verilated accelerator, and its tests.
 EMIT_HOST = "runMain bpaccel.EmitVerilog $(EMIT_ARGS) --target-dir $(HOST_VERILOG)"
 $(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
 	$(SBT) $(EMIT_HOST)
@@ -101,9 +101,9 @@ bench: deps
 	$(MAKE) bench-run ARCH=$(BENCH_ARCH) M=$(BENCH_M) HOST_BIN_DIR=$(BENCH_BIN_DIR)
 
 bench-run: host
-	mkdir -p results; set -o pipefail; $(HOST_BIN_DIR)/bpaccel bench --json results/bench.json $(BENCH_ARGS) | tee results/bench.txt
+	mkdir -p results; set -o pipefail; $(HOST_BIN_DIR)/bpaccel-bench run --json results/bench.json $(BENCH_ARGS) | tee results/bench.txt
 	$(PYTHON) scripts/plot_bench.py --json results/bench.json --out-dir results
-	$(HOST_BIN_DIR)/bpaccel scene --objects 100 --frames 30 --out results/scene.json
+	$(HOST_BIN_DIR)/bpaccel-bench scene --objects 100 --frames 30 --out results/scene.json
 	$(PYTHON) scripts/render_scene.py --json results/scene.json --out results/scene.png
 
 # The seed's sizes, 100,000 and 1,000,000 objects: device cycles from the
@@ -117,7 +117,7 @@ bench-large: deps
 	$(MAKE) bench-large-run ARCH=$(BENCH_ARCH) M=$(BENCH_M) HOST_BIN_DIR=$(BENCH_BIN_DIR)
 
 bench-large-run: host
-	mkdir -p results/large; set -o pipefail; $(HOST_BIN_DIR)/bpaccel bench --json results/large/bench.json $(BENCH_LARGE_ARGS) | tee results/large/bench.txt
+	mkdir -p results/large; set -o pipefail; $(HOST_BIN_DIR)/bpaccel-bench run --json results/large/bench.json $(BENCH_LARGE_ARGS) | tee results/large/bench.txt
 	$(PYTHON) scripts/plot_bench.py --json results/large/bench.json --out-dir results/large
 
 # The same host, Verilated model and tests under AddressSanitizer and
@@ -191,3 +191,6 @@ verilog: deps
 
 clean:
 	rm -rf target project/target generated build test_run_dir
+
+# The AXI shell's targets (shell-verilog, shell-registers, test-shell, shell-fusesoc, shell-synth).
+include mk/shell.mk

@@ -12,6 +12,7 @@ debian_packages=(
   libtbb-dev                             # the host's thread pool
   clang libclang-rt-14-dev               # libFuzzer and the sanitizers
   ccache                                 # the specs' Verilator builds share its runtime objects
+  iverilog                               # the AXI shell's cocotb testbench and FuseSoC simulation
 )
 
 missing=()
@@ -32,17 +33,42 @@ fi
 # tests' PATH. Debian's z3 4.8.12 stalls parsing ChiselTest's encoding of this
 # design, and Debian's CVC4 1.8 got 5 cycles deep where this z3 proves whole
 # runs (docs/verification.md).
-z3_version=5.4.1.0
-tools="$(cd "$here/.." && pwd)/build/formal-tools"
-if [ "$(cat "$tools/z3-version" 2>/dev/null)" != "$z3_version" ]; then
-  echo "deps: installing z3-solver $z3_version into $tools" >&2
-  rm -rf "$tools"
-  python3 -m venv "$tools/venv"
-  "$tools/venv/bin/python" -m pip install --quiet "z3-solver==$z3_version" >&2
-  mkdir -p "$tools/bin"
-  ln -s ../venv/bin/z3 "$tools/bin/z3"
-  "$tools/bin/z3" --version >/dev/null
-  echo "$z3_version" >"$tools/z3-version"
+# A PyPI package, pinned, in a venv of its own at `dir` (made anew when the
+# version differs); `check` then runs in that venv's bin.
+pip_venv() {
+  local dir=$1 package=$2 version=$3 check=$4
+  [ "$(cat "$dir/$package-version" 2>/dev/null)" = "$version" ] && return 0
+  echo "deps: installing $package $version into $dir" >&2
+  rm -rf "$dir"
+  python3 -m venv "$dir/venv"
+  "$dir/venv/bin/python" -m pip install --quiet "$package==$version" >&2
+  (cd "$dir/venv/bin" && eval "$check") >/dev/null
+  echo "$version" >"$dir/$package-version"
+}
+
+build="$(cd "$here/.." && pwd)/build"
+pip_venv "$build/formal-tools" z3-solver 5.4.1.0 "./z3 --version"
+if [ ! -e "$build/formal-tools/bin/z3" ]; then
+  mkdir -p "$build/formal-tools/bin"
+  ln -s ../venv/bin/z3 "$build/formal-tools/bin/z3"
+fi
+
+# The host's code-size check (host/tests/layout/code_size.py, a ctest): lizard,
+# pinned, in a venv of its own.
+pip_venv "$build/host-tools" lizard 1.17.10 "./python -c 'import lizard'"
+
+# The AXI shell's Python tools (docs/integration.md), pinned, in a venv of their own:
+# cocotb and cocotbext-axi for its testbench, FuseSoC for its core file, PeakRDL to
+# check the SystemRDL its register map emits.
+shell_tools_version="cocotb==2.1.0 cocotbext-axi==0.1.28 fusesoc==2.4.7 peakrdl==1.5.0 peakrdl-cheader==1.1.0 peakrdl-regblock==1.3.1 pytest==9.2.0"
+shell_venv="$(cd "$here/.." && pwd)/build/shell-venv"
+if [ "$(cat "$shell_venv/tools-version" 2>/dev/null)" != "$shell_tools_version" ]; then
+  echo "deps: installing the shell's Python tools into $shell_venv" >&2
+  rm -rf "$shell_venv"
+  python3 -m venv "$shell_venv"
+  # shellcheck disable=SC2086
+  "$shell_venv/bin/python" -m pip install --quiet $shell_tools_version >&2
+  echo "$shell_tools_version" >"$shell_venv/tools-version"
 fi
 
 # The sbt launcher (scripts/sbt fetches it too; doing it here keeps `make deps` the one install step).

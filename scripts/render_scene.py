@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Draws one frame of the bouncing-cube scene (the JSON of `bpaccel scene`) as a PNG."""
+"""Draws one frame of the bouncing-cube scene (the JSON of `bpaccel-bench scene`) as a PNG."""
 import pathlib
 import sys
 

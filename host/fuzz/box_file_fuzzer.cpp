@@ -13,7 +13,7 @@
 
 #include <fmt/format.h>
 
-#include "box_file.hpp"
+#include "core/box_file.hpp"
 #include "fuzz_check.hpp"
 
 using namespace bpaccel;

@@ -33,10 +33,12 @@
 
 #include <fmt/format.h>
 
-#include "backend.hpp"
-#include "broad_phase.hpp"
+#include "device/model_backend.hpp"
+#include "device/cpu_backend.hpp"
+#include "device/backend.hpp"
+#include "broad_phase/broad_phase.hpp"
 #include "fuzz_check.hpp"
-#include "keys.hpp"
+#include "core/keys.hpp"
 #include "scenes.hpp"
 
 using namespace bpaccel;
@@ -209,36 +211,46 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::vector<Aabb> boxes = decodeScene(in);
 
   CpuBackend cpu;
-  ModelBackend model(m, capacity, /*runOverheadCycles=*/3, streamReadLatency, batchCells, /*overlapsLoads=*/false,
-                     keyWidth);
+  DeviceParams params = streamReadLatency ? DeviceParams::stream(m, capacity, /*runOverheadCycles=*/3, streamReadLatency)
+                                          : DeviceParams::seed(m, capacity, /*runOverheadCycles=*/3);
+  params.batchCells = batchCells;
+  params.keyWidth = keyWidth;
+  ModelBackend model(params);
   std::vector<Setup> setups;
   std::vector<std::optional<std::size_t>> cells{std::nullopt};
   if (cell) cells.push_back(cell);
   for (const auto& c : cells) {
     const std::string cellName = c ? std::to_string(*c) : "none";
-    setups.push_back({"cpu cell " + cellName, [&cpu, c] { return std::make_unique<BroadPhase>(cpu, c); }});
+    setups.push_back({"cpu cell " + cellName,
+                      [&cpu, c] { return std::make_unique<BroadPhase>(cpu, BroadPhaseConfig{.cellSize = c}); }});
     setups.push_back({fmt::format("model {} m {} capacity {} keys {} cell {} batch {}/{}", arch, m, capacity, keyWidth,
                                   cellName, cellsPerBatch, batchCells),
-                      [&model, c, cellsPerBatch] { return std::make_unique<BroadPhase>(model, c, cellsPerBatch); }});
+                      [&model, c, cellsPerBatch] {
+                        return std::make_unique<BroadPhase>(model,
+                                                            BroadPhaseConfig{.cellSize = c, .cellsPerBatch = cellsPerBatch});
+                      }});
   }
   if (cell) {
     setups.push_back({"cpu grid cell " + std::to_string(*cell), [&cpu, cell] {
-                        return std::make_unique<BroadPhase>(cpu, cell, 1, PartitionKind::UniformGrid);
+                        return std::make_unique<BroadPhase>(
+                            cpu, BroadPhaseConfig{.cellSize = cell, .partition = PartitionKind::UniformGrid});
                       }});
     setups.push_back({fmt::format("model {} m {} capacity {} keys {} grid cell {} batch {}/{}", arch, m, capacity,
                                   keyWidth, *cell, cellsPerBatch, batchCells),
                       [&model, cell, cellsPerBatch] {
-                        return std::make_unique<BroadPhase>(model, cell, cellsPerBatch, PartitionKind::UniformGrid);
+                        return std::make_unique<BroadPhase>(model, BroadPhaseConfig{.cellSize = cell,
+                                                                                    .partition = PartitionKind::UniformGrid,
+                                                                                    .cellsPerBatch = cellsPerBatch});
                       }});
   }
   if (threads > 1 && cell) {
-    const auto makeModel = [m, capacity, streamReadLatency, batchCells, keyWidth]() -> std::unique_ptr<Backend> {
-      return std::make_unique<ModelBackend>(m, capacity, 3, streamReadLatency, batchCells, false, keyWidth);
-    };
+    const auto makeModel = [params]() -> std::unique_ptr<Backend> { return std::make_unique<ModelBackend>(params); };
     setups.push_back({fmt::format("model {} m {} capacity {} keys {} cell {} threads {} batch {}/{}", arch, m, capacity,
                                   keyWidth, *cell, threads, cellsPerBatch, batchCells),
                       [makeModel, cell, threads, cellsPerBatch] {
-                        return std::make_unique<BroadPhase>(makeModel, cell, threads, cellsPerBatch);
+                        return std::make_unique<BroadPhase>(
+                            makeModel,
+                            BroadPhaseConfig{.cellSize = cell, .threads = threads, .cellsPerBatch = cellsPerBatch});
                       }});
   }
   if (const auto bad = firstBoxWithNaN(boxes)) {

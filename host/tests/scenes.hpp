@@ -9,7 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include "types.hpp"
+#include "core/keys.hpp"
+#include "core/types.hpp"
 
 namespace bpaccel::testing {
 
@@ -29,6 +30,13 @@ inline std::vector<Pair> bruteForce(const std::vector<Aabb>& boxes) {
 inline std::vector<Pair> sorted(std::vector<Pair> p) {
   std::sort(p.begin(), p.end());
   return p;
+}
+
+/// The boxes as keys (toKeys).
+inline std::vector<KeyBox> keysOf(const std::vector<Aabb>& boxes) {
+  std::vector<KeyBox> keys;
+  toKeys(boxes, keys);
+  return keys;
 }
 
 inline Aabb box(float x0, float y0, float z0, float x1, float y1, float z1) { return {{x0, y0, z0}, {x1, y1, z1}}; }

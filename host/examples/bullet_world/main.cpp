@@ -1,5 +1,5 @@
 // Boxes dropped on a floor in a Bullet world whose broad phase is
-// bpaccel::Broadphase (the accelerator's C++ model as backend). Exits 0 when
+// bpaccel::BulletDropIn (the accelerator's C++ model as backend). Exits 0 when
 // every box comes to rest on the floor, which needs every box-floor and
 // box-box pair found.
 #include <cmath>
@@ -9,15 +9,16 @@
 
 #include <btBulletDynamicsCommon.h>
 
-#include <bpaccel/bpaccel_params.h>
-#include <bpaccel/bullet_drop_in.hpp>
+#include <bpaccel/device/built_device.hpp>
+#include <bpaccel/device/model_backend.hpp>
+#include <bpaccel/bullet/bullet_drop_in.hpp>
 
 int main() {
   btDefaultCollisionConfiguration config;
   btCollisionDispatcher dispatcher(&config);
   // In place of `btDbvtBroadphase broadphase;`:
-  bpaccel::Broadphase broadphase(
-      std::make_unique<bpaccel::ModelBackend>(BPACCEL_M, BPACCEL_CAPACITY, BPACCEL_RUN_OVERHEAD_CYCLES));
+  bpaccel::BulletDropIn broadphase(
+      std::make_unique<bpaccel::ModelBackend>(bpaccel::builtDeviceParams()));
   btSequentialImpulseConstraintSolver solver;
   btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &config);
   world.setGravity(btVector3(0, -10, 0));

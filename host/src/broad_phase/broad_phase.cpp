@@ -1,0 +1,202 @@
+#include "broad_phase.hpp"
+
+#include <numeric>
+#include <stdexcept>
+#include <utility>
+
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
+
+#include "../core/keys.hpp"
+#include "hand_over.hpp"
+#include "timing.hpp"
+#include "worker.hpp"
+
+namespace bpaccel {
+
+/// The threads of a multi-threaded BroadPhase: an arena of its own, so the
+/// thread count is this object's and nothing is shared with other users of TBB.
+class BroadPhase::Pool {
+ public:
+  explicit Pool(std::size_t threads) : arena_(static_cast<int>(threads)) {}
+  template <typename F>
+  void run(F&& f) {
+    arena_.execute(std::forward<F>(f));
+  }
+
+ private:
+  tbb::task_arena arena_;
+};
+
+BroadPhase::BroadPhase(Backend& backend, const BroadPhaseConfig& config)
+    : BroadPhase(config, [&] {
+        if (config.threads != 1 || config.handOvers != HandOvers::Synchronous)
+          throw std::invalid_argument("broad phase: several threads or asynchronous hand-overs need a backend factory");
+        return std::make_unique<Worker>(
+            [&](AnswerDecoder& decoder, HandOverTimer& timer) {
+              return std::make_unique<SynchronousHandOver>(backend, decoder, timer);
+            },
+            config.cellsPerBatch, config.firstBatch(), config.observer != nullptr);
+      }) {}
+
+BroadPhase::BroadPhase(const BackendFactory& makeBackend, const BroadPhaseConfig& config)
+    : BroadPhase(config, [&] {
+        return std::make_unique<Worker>(
+            [&](AnswerDecoder& decoder, HandOverTimer& timer) {
+              return HandOver::make(config.handOvers, makeBackend, decoder, timer);
+            },
+            config.cellsPerBatch, config.firstBatch(), config.observer != nullptr);
+      }) {}
+
+BroadPhase::BroadPhase(const BroadPhaseConfig& config, const std::function<std::unique_ptr<Worker>()>& makeWorker)
+    : config_(config) {
+  config_.check();
+  for (std::size_t t = 0; t < config_.threads; ++t) workers_.push_back(makeWorker());
+  capacity_ = workers_.front()->backend().capacity;
+  if (capacity_ < 2) throw std::invalid_argument("broad phase: backend capacity must be at least 2");
+  partition_ = makePartition(config_.partition);
+  if (config_.threads > 1) pool_ = std::make_unique<Pool>(config_.threads);
+}
+
+BroadPhase::~BroadPhase() = default;
+
+void BroadPhase::awakenDevices() {
+  if (config_.handOvers != HandOvers::Polled) return;
+  for (auto& w : workers_) w->awaken();
+}
+
+BroadPhase::Clock::time_point BroadPhase::now() const {
+  return config_.observer ? Clock::now() : Clock::time_point{};
+}
+
+void BroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) {
+  const auto t0 = now();
+  // The bounds in the same pass when the partition will use them (timed as conversion).
+  const bool withBounds = config_.cellSize && partition_->needsBounds();
+  KeyBounds bounds;
+  if (withBounds)
+    toKeys(boxes, keys_, bounds);
+  else
+    toKeys(boxes, keys_);
+  const double convert = FrameClock::seconds(t0, now());
+  findKeyPairs(std::span<const KeyBox>(keys_), out, withBounds ? &bounds : nullptr);
+  if (!config_.observer) return;
+  timing_.times.convertSeconds = convert;
+  timing_.times.totalSeconds += convert;
+  for (HandOverRecord& r : timing_.handOvers) r.readySeconds += convert;  // the conversion came first
+  config_.observer->frameFinished(timing_);
+}
+
+void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out) {
+  findKeyPairs(keys, out, nullptr);
+  if (config_.observer) config_.observer->frameFinished(timing_);
+}
+
+void BroadPhase::findKeyPairs(std::span<const KeyBox> keys, std::vector<Pair>& out, const KeyBounds* bounds) {
+  checkObjectCount(keys.size());
+  out.clear();
+  stats_ = {};
+  timing_.times = {};
+  const auto t0 = now();
+  for (auto& w : workers_) w->startFrame(t0);
+  if (!config_.cellSize) {
+    identity_.resize(keys.size());
+    std::iota(identity_.begin(), identity_.end(), 0u);
+    workers_.front()->processCell(keys, DeviceCell::whole(identity_, keys, {}, nullptr, true));
+    workers_.front()->finish();
+    timing_.times.cellsSeconds = FrameClock::seconds(t0, now());
+  } else if (!pool_) {
+    streamCells(keys, bounds);
+  } else {
+    streamCellsToThreads(keys, bounds);
+  }
+  finishCells(out);
+  timing_.times.totalSeconds = timing_.times.partitionSeconds + timing_.times.cellsSeconds;
+}
+
+// Each cell goes to the device as soon as the partition has made it: the tree
+// hands each leaf to a sink while it goes on (the first run is ready long
+// before the tree is finished); other partitions tell when a prefix of their
+// cells is final (the grid: slab by slab), and those cells are gone through
+// here, with no call through a sink and no clock read per cell.
+void BroadPhase::streamCells(std::span<const KeyBox> keys, const KeyBounds* bounds) {
+  const auto t0 = now();
+  Worker& w = *workers_.front();
+  double inCells = 0;
+  const bool lasting = partition_->cellsOutliveBuild();
+  if (partition_->streamsCells()) {
+    partition_->build(keys, *config_.cellSize, [&](const Cell& leaf, std::span<const std::uint32_t> items,
+                                                   std::span<const KeyBox> packed) {
+      const auto c0 = now();
+      w.processCell(keys, DeviceCell::whole(items, packed, {}, &leaf, lasting));
+      inCells += FrameClock::seconds(c0, now());
+    }, bounds);
+  } else {
+    std::size_t done = 0;
+    const auto processUpTo = [&](std::size_t finalCells) {
+      const auto c0 = now();
+      const auto& cells = partition_->cells();
+      for (; done < finalCells; ++done) {
+        const Cell& cell = cells[done];
+        w.processCell(keys, DeviceCell::whole(partition_->items(cell), partition_->packed(cell),
+                                              partition_->below(cell), &cell, lasting));
+      }
+      inCells += FrameClock::seconds(c0, now());
+    };
+    // One reference captured: the sink fits std::function's own storage (no allocation a frame).
+    partition_->buildInSteps(keys, *config_.cellSize, [&processUpTo](std::size_t k) { processUpTo(k); }, bounds);
+  }
+  const auto f0 = now();
+  w.finish();  // the last, partly filled batch
+  inCells += FrameClock::seconds(f0, now());
+  timing_.times.cellsSeconds = inCells;
+  timing_.times.partitionSeconds = FrameClock::seconds(t0, now()) - inCells;
+}
+
+// The calling thread builds the partition and hands each cell to the pool as
+// a task while it goes on; the other threads process cells meanwhile, and the
+// builder joins them when the partition is done. A task gets its own copy of
+// the cell's items and boxes: the tree's storage changes as the build goes on.
+void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys, const KeyBounds* bounds) {
+  const auto t0 = now();
+  Clock::time_point built;
+  pool_->run([&] {
+    tbb::task_group tasks;
+    std::size_t used = 0;
+    partition_->build(keys, *config_.cellSize, [&](const Cell& leaf, std::span<const std::uint32_t> items,
+                                                   std::span<const KeyBox> packed) {
+      if (items.size() < 2) return;  // no pair
+      if (used == cellCopies_.size()) cellCopies_.emplace_back();  // a deque: earlier copies stay put
+      CellCopy& copy = cellCopies_[used++];
+      copy.items.assign(items.begin(), items.end());
+      copy.packed.assign(packed.begin(), packed.end());
+      tasks.run([this, keys, leaf, &copy] {
+        // Inside this arena, thread indices are 0 .. threads-1: one worker each.
+        Worker& w = *workers_.at(static_cast<std::size_t>(tbb::this_task_arena::current_thread_index()));
+        w.processCell(keys, DeviceCell::whole(copy.items, copy.packed, {}, &leaf, false));
+      });
+    }, bounds);
+    built = now();
+    tasks.wait();
+    // Each worker's last, partly filled batch; no task runs any more, so
+    // this thread may use every worker's device.
+    for (auto& w : workers_) w->finish();
+  });
+  timing_.times.partitionSeconds = FrameClock::seconds(t0, built);
+  timing_.times.cellsSeconds = FrameClock::seconds(built, now());
+}
+
+void BroadPhase::finishCells(std::vector<Pair>& out) {
+  timing_.handOvers.clear();
+  // One worker hands its pairs over without a copy (and takes the caller's empty buffer for the next frame).
+  if (workers_.size() == 1) out.swap(workers_.front()->pairs());
+  for (auto& w : workers_) {
+    if (workers_.size() > 1) out.insert(out.end(), w->pairs().begin(), w->pairs().end());
+    stats_ += w->stats();
+    timing_.times.backendSeconds += w->timer().backendSeconds();
+    const auto& records = w->timer().records();
+    timing_.handOvers.insert(timing_.handOvers.end(), records.begin(), records.end());
+  }
+}
+
+}  // namespace bpaccel
