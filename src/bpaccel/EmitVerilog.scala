@@ -65,6 +65,16 @@ object EmitVerilog {
       Array("--target", "systemverilog", "--split-verilog", "--target-dir", targetDir.toString),
       Seq(ChiselGeneratorAnnotation(() => new BroadPhaseAccel(p))) ++ firtoolOptions.map(FirtoolOption(_))
     )
+    finishCore(p, targetDir)
+    Files.writeString(targetDir.resolve(lintWaivers), lintWaiverText)
+    targetDir.resolve("filelist.f")
+  }
+
+  /** What every emission holding the core of `p` gets after firtool: its
+    * memories rewritten for block RAM, the architecture's checks, and the C
+    * header and parameter file.
+    */
+  def finishCore(p: AccelParams, targetDir: Path): Unit = {
     // One clock port per memory, so each maps to block RAM when synthesised on its own.
     SingleClockMemories.rewrite(targetDir)
     // No read meets a write at the same row, so the block RAM needs no collision bypass.
@@ -75,8 +85,6 @@ object EmitVerilog {
       throw new IllegalStateException(s"EmitVerilog: no $memory.sv in $targetDir/filelist.f, which the parameter file names")
     Files.writeString(targetDir.resolve(CHeader.fileName), CHeader(p))
     Files.writeString(targetDir.resolve(ParamsJson.fileName), ParamsJson(p))
-    Files.writeString(targetDir.resolve(lintWaivers), lintWaiverText)
-    targetDir.resolve("filelist.f")
   }
 
   /** Verilator configuration for `verilator --lint-only -Wall lint_waivers.vlt -F filelist.f`. */
