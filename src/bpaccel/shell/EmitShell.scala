@@ -5,7 +5,7 @@ import java.nio.file.{Files, Path, Paths}
 import chisel3.stage.ChiselGeneratorAnnotation
 import circt.stage.{ChiselStage, FirtoolOption}
 
-import bpaccel.{AccelParams, Arch, CHeader, EmitVerilog, LaneEnables, MemoryStyle, NoCollisionMemories, SingleClockMemories}
+import bpaccel.{AccelParams, Arch, EmitVerilog, MemoryStyle, SingleClockMemories}
 
 /** Emits the shell of one configuration: its SystemVerilog (one file per
   * module, filelist.f), the core's bpaccel_params.h, the shell's
@@ -24,11 +24,8 @@ object EmitShell {
       Array("--target", "systemverilog", "--split-verilog", "--target-dir", targetDir.toString),
       Seq(ChiselGeneratorAnnotation(() => new BpaccelShell(p))) ++ firtoolOptions.map(FirtoolOption(_))
     )
-    SingleClockMemories.rewrite(targetDir)
-    NoCollisionMemories.rewrite(targetDir)
-    LaneEnables.check(p.core, targetDir)
+    EmitVerilog.finishCore(p.core, targetDir)
     val map = ShellRegisters(p)
-    Files.writeString(targetDir.resolve("bpaccel_params.h"), CHeader(p.core))
     Files.writeString(targetDir.resolve("bpaccel_shell.h"), ShellHeader(p))
     Files.writeString(targetDir.resolve("bpaccel_shell.rdl"), RegisterMapEmitters.systemRdl(map))
     Files.writeString(targetDir.resolve("registers.md"), RegisterMapEmitters.markdown(map, p))
