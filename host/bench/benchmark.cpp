@@ -29,11 +29,17 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+// first_tenth and last_tenth: the medians of the first and of the last
+// tenth of the frames, in order (at least one frame each), so a method that
+// slows down or speeds up over a run shows it beside its median.
 nlohmann::json summary(const std::vector<double>& v, double scale) {
   if (v.empty()) return nullptr;
+  const auto tenth = static_cast<std::ptrdiff_t>(std::max<std::size_t>(1, v.size() / 10));
   return {{"median", median(v) * scale},
           {"min", *std::min_element(v.begin(), v.end()) * scale},
-          {"max", *std::max_element(v.begin(), v.end()) * scale}};
+          {"max", *std::max_element(v.begin(), v.end()) * scale},
+          {"first_tenth", median(std::vector<double>(v.begin(), v.begin() + tenth)) * scale},
+          {"last_tenth", median(std::vector<double>(v.end() - tenth, v.end())) * scale}};
 }
 
 std::string machineDescription() {
@@ -105,6 +111,7 @@ std::vector<MethodSpec> standardLineUp(const LineUpConfig& config) {
     specs.push_back(std::move(s));
   if (config.cpuThreads > 1)
     for (auto& s : threadedCpuMethods(config.cellSizes, config.cpuThreads)) specs.push_back(std::move(s));
+  for (auto& s : automaticCpuMethods(config.cpuThreads)) specs.push_back(std::move(s));
   return specs;
 }
 
@@ -170,8 +177,12 @@ nlohmann::json Benchmark::run() {
       {"modelled", "accelerator device part (device cycles, loads included, / clock) and transfer part (link model)"},
       {"threads", "every method runs on one thread, but the rows 'cpu k-d C, T threads' (the cpu backend's cells "
                   "shared out among T threads)"}};
+  out["configuration"]["families"] = nlohmann::json::object();
+  for (SceneFamily f : config_.families)
+    out["configuration"]["families"][std::string(familyName(f))] = familyDescription(f);
   out["rows"] = nlohmann::json::array();
-  for (std::size_t n : config_.objectCounts) out["rows"].push_back(runRow(n));
+  for (SceneFamily f : config_.families)
+    for (std::size_t n : config_.objectCounts) out["rows"].push_back(runRow(f, n));
   if (config_.wholeStepObjects) out["whole_step"] = wholeSteps();
   if (!config_.queries.objectCounts.empty()) {
     QueryBenchConfig queries = config_.queries;
@@ -245,17 +256,24 @@ nlohmann::json Benchmark::wholeSteps() {
           {"methods", methods}};
 }
 
-nlohmann::json Benchmark::runRow(std::size_t objects) {
+nlohmann::json Benchmark::runRow(SceneFamily family, std::size_t objects) {
   SceneConfig sc = config_.scene;
   sc.objects = objects;
   const auto tScene = Clock::now();
-  BouncingCubeScene scene(sc);
+  const std::unique_ptr<FrameSource> source = makeFrameSource(family, sc);
+  FrameSource& scene = *source;
   std::vector<Aabb> boxes;
   scene.aabbs(boxes);
   const double sceneSetup = since(tScene);
-  // Objects stay inside the walls; the margin covers a box poking through a wall for a step.
-  const float margin = 2 * sc.maxSize + 2;
-  const SceneStart start{boxes, -margin, scene.cubeEdge() + margin};
+  const auto worldLo = scene.worldLo(), worldHi = scene.worldHi();
+  const SceneStart start{boxes, *std::min_element(worldLo.begin(), worldLo.end()),
+                         *std::max_element(worldHi.begin(), worldHi.end()), worldLo, worldHi};
+  // Failures name the family (but the cube's, the benchmark's first scene).
+  const std::string familyPrefix = family == SceneFamily::Cube ? "" : fmt::format("{}: ", familyName(family));
+  const auto rowName = [&] {
+    return family == SceneFamily::Cube ? fmt::format("n={}", objects)
+                                       : fmt::format("{} n={}", familyName(family), objects);
+  };
 
   std::vector<Entry> entries(lineUp_.size());
   std::vector<std::size_t> active;
@@ -264,10 +282,10 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
     e.spec = &lineUp_[k];
     if (e.spec->skipReason) e.skipped = e.spec->skipReason(start);
     if (e.skipped) {
-      progress_(fmt::format("n={} {}: skipped: {}", objects, e.spec->name, *e.skipped));
+      progress_(fmt::format("{} {}: skipped: {}", rowName(), e.spec->name, *e.skipped));
       continue;
     }
-    progress_(fmt::format("n={} {}: set-up", objects, e.spec->name));
+    progress_(fmt::format("{} {}: set-up", rowName(), e.spec->name));
     const auto t0 = Clock::now();
     e.method = e.spec->make(start);
     e.setupSeconds = since(t0);
@@ -275,7 +293,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
       e.skipped = fmt::format("its set-up took {:.0f} s, above the limit of {:.0f} s (--max-method-seconds)",
                               e.setupSeconds, config_.maxMethodSeconds);
       e.method.reset();
-      progress_(fmt::format("n={} {}: stopped: {}", objects, e.spec->name, *e.skipped));
+      progress_(fmt::format("{} {}: stopped: {}", rowName(), e.spec->name, *e.skipped));
       continue;
     }
     active.push_back(k);
@@ -285,7 +303,7 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
   std::uint64_t exactTotal = 0;
   double physicsSeconds = 0, exactSeconds = 0, validationSeconds = 0;
   const std::size_t totalFrames = config_.warmup + config_.frames;
-  const double energyStart = scene.kineticEnergy();
+  const std::optional<double> energyStart = scene.kineticEnergy();
   std::mt19937 shuffler(sc.seed);
   std::vector<std::size_t> order = active;
   // The method's last pairs against this frame's exact set, and how many it
@@ -316,12 +334,12 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
     const double wall = since(t0);
     const auto [d, duplicates] = checkPairs(*e.method);
     if (d.missing || d.extra || duplicates)
-      throw ValidationFailure(e.spec->name + " (paced run)", objects, frame, d, exact.size());
+      throw ValidationFailure(familyPrefix + e.spec->name + " (paced run)", objects, frame, d, exact.size());
     return wall;
   };
   for (std::size_t frame = 0; frame < totalFrames; ++frame) {
     const bool timed = frame >= config_.warmup;
-    progress_(fmt::format("n={} frame {}/{}{}", objects, frame + 1, totalFrames, timed ? "" : " (warm-up)"));
+    progress_(fmt::format("{} frame {}/{}{}", rowName(), frame + 1, totalFrames, timed ? "" : " (warm-up)"));
     auto t = Clock::now();
     scene.step();
     scene.aabbs(boxes);
@@ -345,12 +363,12 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
       e.extra += d.extra;
       e.duplicates += duplicates;
       if (mustBeExact(e.spec->kind) && (d.missing || d.extra || duplicates))
-        throw ValidationFailure(e.spec->name, objects, frame, d, exact.size());
+        throw ValidationFailure(familyPrefix + e.spec->name, objects, frame, d, exact.size());
       if (wall > config_.maxMethodSeconds) {
         e.skipped = fmt::format("stopped at frame {}: one update took {:.0f} s, above the limit of {:.0f} s "
                                 "(--max-method-seconds); that frame was validated",
                                 frame + 1, wall, config_.maxMethodSeconds);
-        progress_(fmt::format("n={} {}: {}", objects, e.spec->name, *e.skipped));
+        progress_(fmt::format("{} {}: {}", rowName(), e.spec->name, *e.skipped));
         continue;
       }
       if (!timed) continue;
@@ -398,9 +416,11 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
 
   nlohmann::json row;
   row["objects"] = objects;
-  row["cube_edge"] = scene.cubeEdge();
+  row["family"] = familyName(family);
+  row["world"] = {{"lo", worldLo}, {"hi", worldHi}};
+  if (const auto edge = scene.cubeEdge()) row["cube_edge"] = *edge;
   row["exact_pairs_per_frame_mean"] = static_cast<double>(exactTotal) / static_cast<double>(config_.frames);
-  row["kinetic_energy_start_end"] = {energyStart, scene.kineticEnergy()};
+  if (energyStart) row["kinetic_energy_start_end"] = {*energyStart, *scene.kineticEnergy()};
 
   // The baselines a user would pick instead: the fastest of all that found
   // every pair, and the fastest of each library.
@@ -428,7 +448,9 @@ nlohmann::json Benchmark::runRow(std::size_t objects) {
     j["name"] = e.spec->name;
     j["kind"] = kindName(e.spec->kind);
     j["library"] = e.spec->library;
-    j["cell_size"] = e.spec->cellSize ? nlohmann::json(*e.spec->cellSize) : nlohmann::json("none");
+    j["cell_size"] = e.spec->partition == partitionName(PartitionKind::Automatic) ? nlohmann::json("auto")
+                     : e.spec->cellSize ? nlohmann::json(*e.spec->cellSize)
+                                        : nlohmann::json("none");
     if (!e.spec->partition.empty()) j["partition"] = e.spec->partition;
     if (e.skipped) {
       j["skipped"] = *e.skipped;
@@ -504,6 +526,22 @@ std::string Benchmark::table(const nlohmann::json& results) {
   std::string t;
   const auto& rows = results["rows"];
   if (rows.empty()) return t;
+  // One table per scene family, each over that family's rows.
+  std::vector<std::string> families;
+  for (const auto& r : rows)
+    if (const auto f = r.value("family", std::string("cube")); std::find(families.begin(), families.end(), f) == families.end())
+      families.push_back(f);
+  if (families.size() > 1) {
+    for (const auto& f : families) {
+      nlohmann::json part = results;
+      part["rows"] = nlohmann::json::array();
+      for (const auto& r : rows)
+        if (r.value("family", std::string("cube")) == f) part["rows"].push_back(r);
+      t += fmt::format("\n=== Scene family '{}': {} ===\n", f, familyDescription(parseSceneFamily(f)));
+      t += table(part);
+    }
+    return t;
+  }
   const auto& cfg = results["configuration"];
   constexpr std::size_t kName = 32;
   std::vector<std::string> names;  // every method of any row, in line-up order

@@ -14,6 +14,7 @@
 #include "methods/accelerator_method.hpp"
 #include "query_bench.hpp"
 #include "scene.hpp"
+#include "scene_families.hpp"
 #include "methods/timed_method.hpp"
 #include "core/types.hpp"
 
@@ -21,6 +22,8 @@ namespace bpaccel {
 
 struct BenchConfig {
   std::vector<std::size_t> objectCounts{100, 1000, 8000};
+  /// Each family runs every object count, one row each (scene_families.hpp).
+  std::vector<SceneFamily> families{SceneFamily::Cube};
   std::size_t frames = 50;  // timed frames per row
   std::size_t warmup = 5;   // frames simulated and run but not timed
   SceneConfig scene;        // objects is set per row
@@ -73,7 +76,7 @@ class Benchmark {
   static std::string table(const nlohmann::json& results);
 
  private:
-  nlohmann::json runRow(std::size_t objects);
+  nlohmann::json runRow(SceneFamily family, std::size_t objects);
   nlohmann::json wholeSteps();
   BenchConfig config_;
   std::vector<MethodSpec> lineUp_;

@@ -10,13 +10,16 @@
 namespace bpaccel {
 
 /// Every pair (i < j) of boxes that overlap (inclusively) on all axes, sorted.
-/// A uniform grid of cells at least as large as the largest box, each box in
-/// the cell of its min corner, so overlapping boxes sit in neighbouring cells:
-/// linear in n for scenes of similar boxes. Falls back to sortAndSweepPairs
-/// when a coordinate is not finite.
+/// Two ways, whichever tests fewer pairs on this frame (both counted first):
+/// a uniform grid of cells at least as large as the largest box, each box in
+/// the cell of its min corner, so overlapping boxes sit in neighbouring cells
+/// (linear in n for scenes of similar boxes), or a sort and sweep along the
+/// axis on which the fewest pairs overlap (scenes of widely spread sizes, or
+/// clumps in a large world, where the grid's cells would hold many boxes).
+/// Falls back to the sweep when a coordinate is not finite.
 void exactPairs(std::span<const Aabb> boxes, std::vector<Pair>& out);
 
-/// The same set by sort and sweep on x: O(n * boxes overlapping on x).
-void sortAndSweepPairs(std::span<const Aabb> boxes, std::vector<Pair>& out);
+/// The same set by sort and sweep on `axis`: O(n log n + boxes overlapping on that axis).
+void sortAndSweepPairs(std::span<const Aabb> boxes, std::vector<Pair>& out, int axis = 0);
 
 }  // namespace bpaccel

@@ -118,6 +118,23 @@ std::vector<MethodSpec> threadedCpuMethods(const std::vector<std::optional<std::
   return specs;
 }
 
+std::vector<MethodSpec> automaticCpuMethods(std::size_t threads) {
+  std::vector<MethodSpec> specs;
+  for (std::size_t t : {std::size_t{1}, threads}) {
+    if (t < 2 && !specs.empty()) continue;
+    MethodSpec s;
+    s.name = t == 1 ? "cpu auto" : fmt::format("cpu auto, {} threads", t);
+    s.partition = partitionName(PartitionKind::Automatic);
+    s.kind = MethodKind::Cpu;
+    s.library = "bpaccel";
+    s.make = [t](const SceneStart&) {
+      return std::make_unique<CpuMethod>(CellSize::automatic(), t, PartitionKind::Automatic);
+    };
+    specs.push_back(std::move(s));
+  }
+  return specs;
+}
+
 std::vector<MethodSpec> cpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, double maxAllPairsTests,
                                    PartitionKind partition) {
   return perCellSize("cpu", MethodKind::Cpu, partition, cellSizes, maxAllPairsTests,

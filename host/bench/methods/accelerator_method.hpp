@@ -93,8 +93,7 @@ class AcceleratorMethod final : public TimedMethod {
 /// threads the tree is built on one and its cells shared out among them.
 class CpuMethod final : public TimedMethod {
  public:
-  explicit CpuMethod(std::optional<std::size_t> cellSize, std::size_t threads = 1,
-                     PartitionKind partition = PartitionKind::KdTree)
+  explicit CpuMethod(CellSize cellSize, std::size_t threads = 1, PartitionKind partition = PartitionKind::KdTree)
       : phase_([] { return std::make_unique<CpuBackend>(); },
                {.cellSize = cellSize, .partition = partition, .threads = threads}) {}
   void update(std::span<const Aabb> boxes) override { phase_.findPairs(boxes, pairs_); }
@@ -115,5 +114,8 @@ std::vector<MethodSpec> cpuMethods(const std::vector<std::optional<std::size_t>>
                                    PartitionKind partition = PartitionKind::KdTree);
 /// "cpu k-d C, T threads" per cell size with a tree.
 std::vector<MethodSpec> threadedCpuMethods(const std::vector<std::optional<std::size_t>>& cellSizes, std::size_t threads);
+/// "cpu auto" (the broad phase's own choice of partition and cell size) and,
+/// with `threads` above 1, "cpu auto, T threads".
+std::vector<MethodSpec> automaticCpuMethods(std::size_t threads);
 
 }  // namespace bpaccel

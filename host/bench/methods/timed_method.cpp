@@ -29,12 +29,13 @@ SkipRule allPairsSkipReason(double maxTestsPerFrame) {
   };
 }
 
-std::uint64_t pairsOverlappingOnX(std::span<const Aabb> boxes) {
-  std::vector<std::pair<float, float>> xs(boxes.size());  // (min x, max x), sorted by min x
-  std::transform(boxes.begin(), boxes.end(), xs.begin(), [](const Aabb& b) { return std::pair(b.min[0], b.max[0]); });
+std::uint64_t pairsOverlappingOn(std::span<const Aabb> boxes, int axis) {
+  std::vector<std::pair<float, float>> xs(boxes.size());  // (min, max) on the axis, sorted by min
+  std::transform(boxes.begin(), boxes.end(), xs.begin(),
+                 [axis](const Aabb& b) { return std::pair(b.min[axis], b.max[axis]); });
   std::ranges::sort(xs, {}, &std::pair<float, float>::first);
-  // Each pair once: counted at the box that comes first in order of min x,
-  // against every later box whose min x is not beyond its max x.
+  // Each pair once: counted at the box that comes first in order of min,
+  // against every later box whose min is not beyond its max.
   std::uint64_t pairs = 0;
   for (auto it = xs.begin(); it != xs.end(); ++it) {
     const auto end = std::ranges::upper_bound(it + 1, xs.end(), it->second, {}, &std::pair<float, float>::first);

@@ -3,6 +3,7 @@
 // peers', the accelerator's and the cpu backend's. The benchmark's one
 // timing-and-validation loop drives them all.
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -76,6 +77,8 @@ struct SceneStart {
   std::span<const Aabb> boxes;  // the first frame's boxes
   float worldMin = 0;           // every box of every frame stays inside
   float worldMax = 0;           // [worldMin, worldMax] on each axis
+  /// The same bounds per axis (a flat world is not a cube): inside [worldMin, worldMax].
+  std::array<float, 3> worldLo{}, worldHi{};
 };
 
 /// One entry of the benchmark's line-up: how to name, skip and build a method.
@@ -96,9 +99,11 @@ using SkipRule = std::function<std::optional<std::string>(const SceneStart&)>;
 /// are skipped where that exceeds `maxTestsPerFrame`.
 SkipRule allPairsSkipReason(double maxTestsPerFrame);
 
-/// The number of pairs of boxes whose x intervals overlap (closed): the
-/// interval tests of a sort-and-sweep along x. O(n log n).
-std::uint64_t pairsOverlappingOnX(std::span<const Aabb> boxes);
+/// The number of pairs of boxes whose intervals on `axis` overlap (closed):
+/// the interval tests of a sort-and-sweep along that axis. O(n log n).
+std::uint64_t pairsOverlappingOn(std::span<const Aabb> boxes, int axis);
+/// The same along x.
+inline std::uint64_t pairsOverlappingOnX(std::span<const Aabb> boxes) { return pairsOverlappingOn(boxes, 0); }
 
 /// The skip rule of a sort-and-sweep along x that cannot be interrupted (set-up
 /// or rebuild): skipped where the scene's pairsOverlappingOnX exceeds `maxTests`.

@@ -3,6 +3,7 @@
 //
 //   bpaccel-bench run [--objects N ...] [--json FILE] ...   (see --help)
 //   bpaccel-bench scene [--objects N] [--frames F] [--out FILE]
+//   bpaccel-bench boxes [--family F] [--objects N] [--frame K] [--out FILE]
 
 #include <algorithm>
 #include <filesystem>
@@ -21,6 +22,8 @@
 #include "device/backend.hpp"
 #include "benchmark.hpp"
 #include "scene.hpp"
+#include "scene_families.hpp"
+#include "core/box_file.hpp"
 #include "bpaccel_params.h"
 #include "broad_phase/broad_phase.hpp"
 #include "device/rtl/rtl_backend.hpp"
@@ -64,7 +67,7 @@ int runBench(const bpaccel::BenchConfig& config, bpaccel::LineUpConfig lineUp, c
              const std::string& jsonPath) {
   lineUp.cellSizes.clear();
   for (const auto& c : cells) lineUp.cellSizes.push_back(bpaccel::parseCellSize(c));
-  fmt::print(stderr, "bench: clock {}\n", lineUp.device->clockSource);
+  if (lineUp.device) fmt::print(stderr, "bench: clock {}\n", lineUp.device->clockSource);
   bpaccel::Benchmark bench(config, bpaccel::standardLineUp(lineUp), bpaccel::describe(lineUp),
                            [](const std::string& line) { fmt::print(stderr, "bench: {}\n", line); });
   nlohmann::json results;
@@ -102,6 +105,22 @@ int runScene(const bpaccel::SceneConfig& config, std::size_t frames, const std::
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
   std::ofstream(path) << j.dump(1) << "\n";
   fmt::print(stderr, "scene: wrote {} objects after {} frames to {}\n", scene.size(), frames, out);
+  return 0;
+}
+
+// One frame of a scene family in the box-file format of `bpaccel pairs --input`.
+int runBoxes(bpaccel::SceneConfig config, const std::string& family, std::size_t frame, const std::string& out) {
+  const auto source = bpaccel::makeFrameSource(bpaccel::parseSceneFamily(family), config);
+  for (std::size_t f = 0; f < frame; ++f) source->step();
+  std::vector<bpaccel::Aabb> boxes;
+  source->aabbs(boxes);
+  const std::filesystem::path path(out);
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  std::ofstream file(path);
+  file << fmt::format("# {} {} objects, frame {}, seed {}\n", family, boxes.size(), frame, config.seed);
+  bpaccel::writeBoxes(file, boxes);
+  if (!file) throw std::runtime_error("cannot write " + out);
+  fmt::print(stderr, "boxes: wrote {} boxes of {} (frame {}) to {}\n", boxes.size(), family, frame, out);
   return 0;
 }
 
@@ -145,6 +164,15 @@ int main(int argc, char** argv) {
   };
   benchCmd->add_option("--objects", bench.objectCounts, "Object counts, one table row each")->capture_default_str()
       ->check(CLI::PositiveNumber);
+  std::vector<std::string> families = {"cube"};
+  benchCmd->add_option("--families", families,
+                       "Scene families, each at every object count: cube (Bullet's bouncing cube), sizes, clusters, "
+                       "flat, poles, layer")
+      ->capture_default_str();
+  bool accelerator = true;
+  benchCmd->add_flag("--accelerator,!--no-accelerator", accelerator,
+                     "Run the accelerator's rows (a Verilated or modelled device beside the software)")
+      ->capture_default_str();
   benchCmd->add_option("--cell-sizes", benchCells, "k-d tree cell sizes ('none' = no tree)")->capture_default_str();
   benchCmd->add_option("--grid-cell-sizes", lineUp.gridCellSizes,
                        "Cell sizes of the extra 'accelerator grid C' and 'cpu grid C' rows (uniform grid partition)")
@@ -209,13 +237,27 @@ int main(int argc, char** argv) {
   sceneCmd->add_option("--out", sceneOut, "Output JSON")->capture_default_str();
   addSceneOptions(sceneCmd, sceneConfig);
 
+  bpaccel::SceneConfig boxesConfig;
+  std::string boxesFamily = "cube", boxesOut = "boxes.txt";
+  std::size_t boxesFrame = 0;
+  auto* boxesCmd = app.add_subcommand("boxes", "Write one frame of a scene family as a box file (bpaccel pairs --input)");
+  boxesCmd->add_option("--family", boxesFamily, "cube, sizes, clusters, flat, poles or layer")->capture_default_str();
+  boxesCmd->add_option("--objects", boxesConfig.objects, "Objects")->capture_default_str()->check(CLI::PositiveNumber);
+  boxesCmd->add_option("--frame", boxesFrame, "Frames to move the scene first")->capture_default_str();
+  boxesCmd->add_option("--out", boxesOut, "Output box file")->capture_default_str();
+  addSceneOptions(boxesCmd, boxesConfig);
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (*benchCmd) {
-      lineUp.device = makeDevice(benchBackend, clockMHz, fpgaReport, linkGBytesPerSecond, linkLatencyUs,
-                                 cellsPerBatch, firstBatchCells, paced);
+      bench.families.clear();
+      for (const auto& f : families) bench.families.push_back(bpaccel::parseSceneFamily(f));
+      if (accelerator)
+        lineUp.device = makeDevice(benchBackend, clockMHz, fpgaReport, linkGBytesPerSecond, linkLatencyUs,
+                                   cellsPerBatch, firstBatchCells, paced);
       return runBench(bench, lineUp, benchCells, benchJson);
     }
+    if (*boxesCmd) return runBoxes(boxesConfig, boxesFamily, boxesFrame, boxesOut);
     return runScene(sceneConfig, sceneFrames, sceneOut);
   } catch (const std::exception& e) {
     fmt::print(stderr, "bpaccel-bench: {}\n", e.what());

@@ -9,6 +9,7 @@
 
 #include "../core/keys.hpp"
 #include "hand_over.hpp"
+#include "host_frame.hpp"
 #include "timing.hpp"
 #include "worker.hpp"
 
@@ -28,33 +29,48 @@ class BroadPhase::Pool {
   tbb::task_arena arena_;
 };
 
-BroadPhase::BroadPhase(Backend& backend, const BroadPhaseConfig& config)
-    : BroadPhase(config, [&] {
-        if (config.threads != 1 || config.handOvers != HandOvers::Synchronous)
-          throw std::invalid_argument("broad phase: several threads or asynchronous hand-overs need a backend factory");
-        return std::make_unique<Worker>(
-            [&](AnswerDecoder& decoder, HandOverTimer& timer) {
-              return std::make_unique<SynchronousHandOver>(backend, decoder, timer);
-            },
-            config.cellsPerBatch, config.firstBatch(), config.observer != nullptr);
-      }) {}
-
-BroadPhase::BroadPhase(const BackendFactory& makeBackend, const BroadPhaseConfig& config)
-    : BroadPhase(config, [&] {
-        return std::make_unique<Worker>(
-            [&](AnswerDecoder& decoder, HandOverTimer& timer) {
-              return HandOver::make(config.handOvers, makeBackend, decoder, timer);
-            },
-            config.cellsPerBatch, config.firstBatch(), config.observer != nullptr);
-      }) {}
-
-BroadPhase::BroadPhase(const BroadPhaseConfig& config, const std::function<std::unique_ptr<Worker>()>& makeWorker)
-    : config_(config) {
+BroadPhase::BroadPhase(Backend& backend, const BroadPhaseConfig& config) : config_(config) {
   config_.check();
+  if (config_.threads != 1 || config_.handOvers != HandOvers::Synchronous)
+    throw std::invalid_argument("broad phase: several threads or asynchronous hand-overs need a backend factory");
+  if (const AllPairsKernel* kernel = backend.hostKernel()) {
+    host_ = std::make_unique<HostFrame>(*kernel, config_);
+    return;
+  }
+  startWorkers([&] {
+    return std::make_unique<Worker>(
+        [&](AnswerDecoder& decoder, HandOverTimer& timer) {
+          return std::make_unique<SynchronousHandOver>(backend, decoder, timer);
+        },
+        config_.cellsPerBatch, config_.firstBatch(), config_.observer != nullptr);
+  });
+}
+
+BroadPhase::BroadPhase(const BackendFactory& makeBackend, const BroadPhaseConfig& config) : config_(config) {
+  config_.check();
+  if (config_.handOvers == HandOvers::Synchronous) {
+    const std::unique_ptr<Backend> probe = makeBackend();
+    if (probe && probe->hostKernel()) {
+      host_ = std::make_unique<HostFrame>(*probe->hostKernel(), config_);
+      return;
+    }
+  }
+  startWorkers([&] {
+    return std::make_unique<Worker>(
+        [&](AnswerDecoder& decoder, HandOverTimer& timer) {
+          return HandOver::make(config_.handOvers, makeBackend, decoder, timer);
+        },
+        config_.cellsPerBatch, config_.firstBatch(), config_.observer != nullptr);
+  });
+}
+
+void BroadPhase::startWorkers(const std::function<std::unique_ptr<Worker>()>& makeWorker) {
   for (std::size_t t = 0; t < config_.threads; ++t) workers_.push_back(makeWorker());
   capacity_ = workers_.front()->backend().capacity;
   if (capacity_ < 2) throw std::invalid_argument("broad phase: backend capacity must be at least 2");
-  partition_ = makePartition(config_.partition);
+  tree_ = makePartition(PartitionKind::KdTree);
+  grid_ = makePartition(PartitionKind::UniformGrid);
+  partition_ = config_.partition == PartitionKind::UniformGrid ? grid_.get() : tree_.get();
   if (config_.threads > 1) pool_ = std::make_unique<Pool>(config_.threads);
 }
 
@@ -65,14 +81,37 @@ void BroadPhase::awakenDevices() {
   for (auto& w : workers_) w->awaken();
 }
 
+const RunStats& BroadPhase::stats() const { return host_ ? host_->stats() : stats_; }
+const Partition& BroadPhase::partition() const { return host_ ? host_->partition() : *partition_; }
+const CellChoice& BroadPhase::choice() const { return host_ ? host_->choice() : choice_; }
+std::size_t BroadPhase::threads() const { return host_ ? host_->threads() : workers_.size(); }
+
+void BroadPhase::chooseCells(std::size_t objects, const KeyBounds* bounds) {
+  if (config_.cellSize.isAutomatic()) {
+    choice_ = chooser_.choose(objects, bounds ? *bounds : KeyBounds{}, config_.partition);
+  } else {
+    const PartitionKind kind =
+        config_.partition == PartitionKind::UniformGrid ? PartitionKind::UniformGrid : PartitionKind::KdTree;
+    choice_ = {kind, config_.cellSize.fixed()};
+  }
+  partition_ = choice_.kind == PartitionKind::UniformGrid ? grid_.get() : tree_.get();
+}
+
 BroadPhase::Clock::time_point BroadPhase::now() const {
   return config_.observer ? Clock::now() : Clock::time_point{};
 }
 
 void BroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) {
+  if (host_) {
+    host_->findPairs(boxes, out);
+    if (config_.observer) config_.observer->frameFinished(host_->timing());
+    return;
+  }
   const auto t0 = now();
-  // The bounds in the same pass when the partition will use them (timed as conversion).
-  const bool withBounds = config_.cellSize && partition_->needsBounds();
+  // The bounds in the same pass when the partition will use them (timed as
+  // conversion): the grid's, and the automatic choice's.
+  const bool withBounds = config_.cellSize.isAutomatic() ||
+                          (config_.cellSize.fixed() && config_.partition == PartitionKind::UniformGrid);
   KeyBounds bounds;
   if (withBounds)
     toKeys(boxes, keys_, bounds);
@@ -88,6 +127,11 @@ void BroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) 
 }
 
 void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out) {
+  if (host_) {
+    host_->findPairs(keys, out);
+    if (config_.observer) config_.observer->frameFinished(host_->timing());
+    return;
+  }
   findKeyPairs(keys, out, nullptr);
   if (config_.observer) config_.observer->frameFinished(timing_);
 }
@@ -98,8 +142,14 @@ void BroadPhase::findKeyPairs(std::span<const KeyBox> keys, std::vector<Pair>& o
   stats_ = {};
   timing_.times = {};
   const auto t0 = now();
+  KeyBounds found;
+  if (!bounds && config_.cellSize.isAutomatic()) {
+    found = boundsOf(keys);
+    bounds = &found;
+  }
+  chooseCells(keys.size(), bounds);
   for (auto& w : workers_) w->startFrame(t0);
-  if (!config_.cellSize) {
+  if (!choice_.cellSize) {
     identity_.resize(keys.size());
     std::iota(identity_.begin(), identity_.end(), 0u);
     workers_.front()->processCell(keys, DeviceCell::whole(identity_, keys, {}, nullptr, true));
@@ -111,6 +161,7 @@ void BroadPhase::findKeyPairs(std::span<const KeyBox> keys, std::vector<Pair>& o
     streamCellsToThreads(keys, bounds);
   }
   finishCells(out);
+  if (config_.cellSize.isAutomatic() && choice_.cellSize) chooser_.observe(choice_, occupancyOf(*partition_, keys.size()));
   timing_.times.totalSeconds = timing_.times.partitionSeconds + timing_.times.cellsSeconds;
 }
 
@@ -125,7 +176,7 @@ void BroadPhase::streamCells(std::span<const KeyBox> keys, const KeyBounds* boun
   double inCells = 0;
   const bool lasting = partition_->cellsOutliveBuild();
   if (partition_->streamsCells()) {
-    partition_->build(keys, *config_.cellSize, [&](const Cell& leaf, std::span<const std::uint32_t> items,
+    partition_->build(keys, *choice_.cellSize, [&](const Cell& leaf, std::span<const std::uint32_t> items,
                                                    std::span<const KeyBox> packed) {
       const auto c0 = now();
       w.processCell(keys, DeviceCell::whole(items, packed, {}, &leaf, lasting));
@@ -144,7 +195,7 @@ void BroadPhase::streamCells(std::span<const KeyBox> keys, const KeyBounds* boun
       inCells += FrameClock::seconds(c0, now());
     };
     // One reference captured: the sink fits std::function's own storage (no allocation a frame).
-    partition_->buildInSteps(keys, *config_.cellSize, [&processUpTo](std::size_t k) { processUpTo(k); }, bounds);
+    partition_->buildInSteps(keys, *choice_.cellSize, [&processUpTo](std::size_t k) { processUpTo(k); }, bounds);
   }
   const auto f0 = now();
   w.finish();  // the last, partly filled batch
@@ -163,7 +214,7 @@ void BroadPhase::streamCellsToThreads(std::span<const KeyBox> keys, const KeyBou
   pool_->run([&] {
     tbb::task_group tasks;
     std::size_t used = 0;
-    partition_->build(keys, *config_.cellSize, [&](const Cell& leaf, std::span<const std::uint32_t> items,
+    partition_->build(keys, *choice_.cellSize, [&](const Cell& leaf, std::span<const std::uint32_t> items,
                                                    std::span<const KeyBox> packed) {
       if (items.size() < 2) return;  // no pair
       if (used == cellCopies_.size()) cellCopies_.emplace_back();  // a deque: earlier copies stay put

@@ -6,8 +6,14 @@
 
 namespace bpaccel {
 
+std::optional<std::size_t> CellSize::fixed() const {
+  if (kind_ == Kind::Automatic) throw std::logic_error("cell size: automatic, not fixed");
+  return kind_ == Kind::None ? std::nullopt : std::optional<std::size_t>(boxes_);
+}
+
 void BroadPhaseConfig::check() const {
-  if (cellSize && *cellSize < 1) throw std::invalid_argument("broad phase: cell size must be at least 1");
+  if (!cellSize.isAutomatic() && cellSize.fixed() && *cellSize.fixed() < 1)
+    throw std::invalid_argument("broad phase: cell size must be at least 1");
   if (threads < 1) throw std::invalid_argument("broad phase: at least one thread");
   if (cellsPerBatch < 1) throw std::invalid_argument("broad phase: cells per batch must be at least 1");
   if (handOvers != HandOvers::Synchronous && cellsPerBatch < 2)
@@ -31,5 +37,7 @@ std::optional<std::size_t> parseCellSize(const std::string& text) {
 std::string cellSizeName(const std::optional<std::size_t>& cellSize) {
   return cellSize ? std::to_string(*cellSize) : "none";
 }
+
+std::string CellSize::name() const { return isAutomatic() ? "auto" : cellSizeName(fixed()); }
 
 }  // namespace bpaccel

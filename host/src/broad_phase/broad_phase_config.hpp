@@ -39,10 +39,39 @@ inline constexpr std::size_t kBatchesInFlight = 3;
 /// here (up to about 0.1 ms), short enough that it sleeps between frames.
 inline constexpr std::chrono::microseconds kDevicePollMicroseconds{250};
 
+/// How many boxes a cell holds, about (each partition's own rule): a number,
+/// none (the scene is one cell) or automatic (the default: the broad phase
+/// chooses it, and the partition too unless one is named, frame by frame;
+/// automatic_choice.hpp). Converts from a number, std::nullopt and
+/// std::optional<std::size_t>, as the older optional field did.
+class CellSize {
+ public:
+  constexpr CellSize() = default;
+  constexpr CellSize(std::size_t boxes) : kind_(Kind::Boxes), boxes_(boxes) {}  // NOLINT: a number is a cell size
+  constexpr CellSize(std::nullopt_t) : kind_(Kind::None) {}                    // NOLINT
+  constexpr CellSize(const std::optional<std::size_t>& c)                      // NOLINT
+      : kind_(c ? Kind::Boxes : Kind::None), boxes_(c.value_or(0)) {}
+  static constexpr CellSize automatic() { return {}; }
+  constexpr bool isAutomatic() const { return kind_ == Kind::Automatic; }
+  /// The fixed choice: a number, or nullopt for none. Throws std::logic_error when automatic.
+  std::optional<std::size_t> fixed() const;
+  /// "auto", or cellSizeName of the fixed choice.
+  std::string name() const;
+  friend constexpr bool operator==(const CellSize&, const CellSize&) = default;
+
+ private:
+  enum class Kind { Automatic, None, Boxes };
+  Kind kind_ = Kind::Automatic;
+  std::size_t boxes_ = 0;
+};
+
 struct BroadPhaseConfig {
-  /// Boxes a cell holds, about (each partition's own rule); none: the scene is one cell.
-  std::optional<std::size_t> cellSize;
-  PartitionKind partition = PartitionKind::KdTree;
+  /// Automatic by default; see CellSize.
+  CellSize cellSize;
+  /// Automatic (the default) with an automatic cell size: both chosen each
+  /// frame; with a cell size of the caller's: the k-d tree, as a cell size
+  /// given alone has always meant.
+  PartitionKind partition = PartitionKind::Automatic;
   /// Workers, each with a device of its own (only with a backend factory).
   std::size_t threads = 1;
   /// Cells per hand-over to the device (Backend::runBatch); 1 hands each cell
@@ -69,5 +98,6 @@ struct BroadPhaseConfig {
 std::optional<std::size_t> parseCellSize(const std::string& text);
 /// The same spelling of a cell size.
 std::string cellSizeName(const std::optional<std::size_t>& cellSize);
+
 
 }  // namespace bpaccel

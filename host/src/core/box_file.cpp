@@ -101,4 +101,18 @@ std::vector<Aabb> readBoxes(std::istream& in) {
   return boxes;
 }
 
+void writeBoxes(std::ostream& out, std::span<const Aabb> boxes) {
+  std::string text;
+  for (const Aabb& b : boxes) {
+    // fmt writes a float as its shortest round-trip form ("inf", "-0", "1e-45").
+    fmt::format_to(std::back_inserter(text), "{} {} {} {} {} {}\n", b.min[0], b.min[1], b.min[2], b.max[0], b.max[1],
+                   b.max[2]);
+    if (text.size() > (1u << 16)) {
+      out.write(text.data(), static_cast<std::streamsize>(text.size()));
+      text.clear();
+    }
+  }
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
+}
+
 }  // namespace bpaccel

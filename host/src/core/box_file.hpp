@@ -2,6 +2,8 @@
 // The text format of `bpaccel pairs --input`: one box a line.
 
 #include <istream>
+#include <ostream>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -29,5 +31,10 @@ class ParseError : public std::runtime_error {
 /// min > max) throws ParseError with its 1-based line number; nothing is
 /// returned partially.
 std::vector<Aabb> readBoxes(std::istream& in);
+
+/// Writes `boxes` one a line in the format readBoxes reads, each number the
+/// shortest text that reads back as the same float (-0 stays -0, infinities
+/// are written inf and -inf), so a written file reads back bit for bit.
+void writeBoxes(std::ostream& out, std::span<const Aabb> boxes);
 
 }  // namespace bpaccel

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "cpu_features.hpp"
+#include "thread_pool.hpp"
 
 namespace bpaccel {
 
@@ -60,7 +61,7 @@ bool isBad(const Aabb& b, const KeyBox& k) {
          static_cast<int>(k.min[2] > k.max[2]);
 }
 
-[[noreturn]] void throwFirstBad(std::span<const Aabb> boxes, const std::vector<KeyBox>& keys) {
+[[noreturn]] void throwFirstBad(std::span<const Aabb> boxes, std::span<const KeyBox> keys) {
   static constexpr const char* kAxis[3] = {"x", "y", "z"};
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     const Aabb& b = boxes[i];
@@ -120,7 +121,7 @@ class BoundsSse2 {
 // so they stay in registers: the stores to `out` could alias anything
 // reached by pointer.
 template <bool kBounds>
-std::size_t toKeysSse2(std::span<const Aabb> boxes, std::vector<KeyBox>& out, std::size_t i, bool& bad,
+std::size_t toKeysSse2(std::span<const Aabb> boxes, std::span<KeyBox> out, std::size_t i, bool& bad,
                        KeyBounds* bounds) {
   BoundsSse2 lanes;
   static_assert(sizeof(Aabb) == 24 && sizeof(KeyBox) == 24, "two boxes are three 16-byte vectors");
@@ -192,7 +193,7 @@ __attribute__((target("avx2"))) void mergeLanesAvx2(const __m256i (&least)[3], c
 }
 
 template <bool kBounds>
-__attribute__((target("avx2"))) std::size_t toKeysAvx2(std::span<const Aabb> boxes, std::vector<KeyBox>& out,
+__attribute__((target("avx2"))) std::size_t toKeysAvx2(std::span<const Aabb> boxes, std::span<KeyBox> out,
                                                         bool& bad, KeyBounds* bounds) {
   static_assert(sizeof(Aabb) == 24 && sizeof(KeyBox) == 24, "four boxes are three 32-byte vectors");
   const __m256i signBit = _mm256_set1_epi32(static_cast<int>(kSignBit));
@@ -250,13 +251,11 @@ void addBox(const KeyBox& k, KeyBounds& bounds) {
   }
 }
 
-// toKeys, with the bounds when `bounds` is given (a loop of its own each, so
-// the common call without them pays nothing).
-void convert(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds* bounds) {
-  checkObjectCount(boxes.size());
-  out.resize(boxes.size());
-  // Branch-free passes that convert and only accumulate a flag; the rare bad
-  // input is located afterwards.
+// Converts boxes into out (the same size), with their bounds when `bounds`
+// is given (a loop of its own each, so the common call without them pays
+// nothing). Branch-free passes that convert and only accumulate a flag;
+// returns whether a box was bad (the rare bad input is located afterwards).
+bool convertPart(std::span<const Aabb> boxes, std::span<KeyBox> out, KeyBounds* bounds) {
   bool bad = false;
   std::size_t first = 0;
 #if defined(__x86_64__)
@@ -275,7 +274,13 @@ void convert(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds* b
     bad |= isBad(b, k);
     if (bounds) addBox(k, *bounds);
   }
-  if (bad) [[unlikely]]
+  return bad;
+}
+
+void convert(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds* bounds) {
+  checkObjectCount(boxes.size());
+  out.resize(boxes.size());
+  if (convertPart(boxes, out, bounds)) [[unlikely]]
     throwFirstBad(boxes, out);
 }
 
@@ -286,6 +291,29 @@ void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out) { convert(box
 void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds& bounds) {
   bounds = {};
   convert(boxes, out, &bounds);
+}
+
+void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds& bounds, ThreadPool& pool) {
+  checkObjectCount(boxes.size());
+  out.resize(boxes.size());
+  const std::size_t parts = pool.partsOf(boxes.size());
+  std::vector<KeyBounds> partBounds(parts);
+  std::vector<char> partBad(parts, 0);
+  pool.forParts(boxes.size(), [&](std::size_t k, std::size_t begin, std::size_t end) {
+    partBad[k] = convertPart(boxes.subspan(begin, end - begin), std::span<KeyBox>(out).subspan(begin, end - begin),
+                             &partBounds[k]);
+  });
+  bounds = {};
+  bool bad = false;
+  for (std::size_t k = 0; k < parts; ++k) {
+    bad |= partBad[k] != 0;
+    for (int a = 0; a < 3; ++a) {
+      bounds.lo[a] = std::min(bounds.lo[a], partBounds[k].lo[a]);
+      bounds.hi[a] = std::max(bounds.hi[a], partBounds[k].hi[a]);
+    }
+  }
+  if (bad) [[unlikely]]
+    throwFirstBad(boxes, out);
 }
 
 KeyBounds boundsOf(std::span<const KeyBox> boxes) {

@@ -11,6 +11,8 @@
 
 namespace bpaccel {
 
+class ThreadPool;
+
 /// Bad input, naming the object (index) and the reason.
 class InputError : public std::runtime_error {
  public:
@@ -36,6 +38,10 @@ void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out);
 /// The same, and the scene's bounds found in the same pass (a partition that
 /// needs them then skips a pass of its own over the keys).
 void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds& bounds);
+
+/// The same on the pool's threads, each converting a contiguous part (the
+/// first bad box is still the one named).
+void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds& bounds, ThreadPool& pool);
 
 /// The bounds of boxes already converted.
 KeyBounds boundsOf(std::span<const KeyBox> boxes);

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "../core/all_pairs_kernel.hpp"
 #include "../core/types.hpp"
 
 namespace bpaccel {
@@ -48,6 +49,11 @@ class Backend {
   /// checks the pairs it gets back with the full keys, as BroadPhase does;
   /// keys wider than this are refused, never cut.
   virtual unsigned keyWidth() const { return 32; }
+  /// The kernel of a backend that is software on the host's own cores (the
+  /// cpu backend): the broad phase then runs its cells itself, on its
+  /// threads, reading each cell's boxes from the frame's keys and keeping
+  /// only the pairs a cell owns (no hand-over, no decoding). Null for a device.
+  virtual const AllPairsKernel* hostKernel() const { return nullptr; }
   /// Whether runBipartite() exists here (the stream architecture's device and its model).
   virtual bool bipartite() const { return false; }
   /// One bipartite run (one run, one batch): appends only the overlapping

@@ -20,6 +20,7 @@ class CpuBackend final : public Backend {
   std::size_t capacity() const override { return std::numeric_limits<std::size_t>::max(); }
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
   std::string_view isa() const { return kernel_.isa(); }
+  const AllPairsKernel* hostKernel() const override { return &kernel_; }
 
  private:
   AllPairsKernel kernel_;

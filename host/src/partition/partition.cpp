@@ -12,12 +12,20 @@ std::unique_ptr<Partition> makePartition(PartitionKind kind) {
   return std::make_unique<KdTree>();
 }
 
-std::string_view partitionName(PartitionKind kind) { return kind == PartitionKind::UniformGrid ? "grid" : "k-d"; }
+std::string_view partitionName(PartitionKind kind) {
+  switch (kind) {
+    case PartitionKind::UniformGrid: return "grid";
+    case PartitionKind::Automatic: return "auto";
+    case PartitionKind::KdTree: break;
+  }
+  return "k-d";
+}
 
 PartitionKind parsePartitionKind(const std::string& text) {
   if (text == "kd") return PartitionKind::KdTree;
   if (text == "grid") return PartitionKind::UniformGrid;
-  throw std::invalid_argument("partition '" + text + "' is neither 'kd' nor 'grid'");
+  if (text == "auto") return PartitionKind::Automatic;
+  throw std::invalid_argument("partition '" + text + "' is not 'kd', 'grid' or 'auto'");
 }
 
 }  // namespace bpaccel

@@ -18,6 +18,8 @@
 
 namespace bpaccel {
 
+class ThreadPool;
+
 /// One cell: a half-open region [lo, hi) of key space and its boxes. The
 /// cells of a partition cover key space without overlap, and every box is in
 /// every cell whose region it touches, so every point p lies in exactly one
@@ -78,6 +80,14 @@ class Partition {
     build(boxes, cellSize, {}, bounds);
     if (onStep) onStep(cells().size());
   }
+  /// Builds the cells and their items (and below() bits where the kind has
+  /// them) for a caller that reads each cell's boxes itself from the keys:
+  /// packed() may then be empty. A kind that can share the work does so on
+  /// `pool` (if any); by default build() without a sink.
+  virtual void buildIndex(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds* bounds,
+                          ThreadPool* /*pool*/) {
+    build(boxes, cellSize, {}, bounds);
+  }
   /// A cell of the last build, its boxes packed in item order, when the
   /// partition keeps them until the next build; else empty.
   virtual std::span<const KeyBox> packed(const Cell&) const { return {}; }
@@ -94,12 +104,16 @@ inline std::uint8_t belowBits(const std::array<std::uint32_t, 3>& min, const std
                                    static_cast<unsigned>(min[2] < lo[2]) << 2);
 }
 
-enum class PartitionKind { KdTree, UniformGrid };
+/// Automatic: the broad phase chooses the kind (and, when the cell size is
+/// automatic too, the cell size) frame by frame (automatic_choice.hpp).
+enum class PartitionKind { KdTree, UniformGrid, Automatic };
 
+/// The k-d tree or the grid (Automatic: the k-d tree, the kind a cell size
+/// given alone has always meant).
 std::unique_ptr<Partition> makePartition(PartitionKind kind);
-/// "k-d" or "grid".
+/// "k-d", "grid" or "auto".
 std::string_view partitionName(PartitionKind kind);
-/// "kd" or "grid" (the CLI's spelling); throws std::invalid_argument naming the text otherwise.
+/// "kd", "grid" or "auto" (the CLI's spelling); throws std::invalid_argument naming the text otherwise.
 PartitionKind parsePartitionKind(const std::string& text);
 
 /// The reference point of an overlapping pair: the low corner of the two

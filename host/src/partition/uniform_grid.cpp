@@ -13,6 +13,7 @@
 
 #include "../core/cpu_features.hpp"
 #include "../core/keys.hpp"
+#include "../core/thread_pool.hpp"
 
 namespace bpaccel {
 namespace {
@@ -416,62 +417,62 @@ std::array<std::uint32_t, 3> UniformGrid::resolution() const {
 // that straddle a plane (about a third on the bench's scene) are listed and
 // their other cells counted after, so the common case has no branch to
 // mispredict. The cells of four boxes (24 keys) are computed at a time with
-// AVX2 where the CPU has it, of two with SSE2 for the rest.
-bool UniformGrid::countBoxes(std::span<const KeyBox> boxes) {
-  countFirstCells(boxes);
-  return countOtherCells(boxes.size());
-}
-
-void UniformGrid::countFirstCells(std::span<const KeyBox> boxes) {
+// AVX2 where the CPU has it, of two with SSE2 for the rest. Each part of the
+// boxes (one a thread) counts into its own counters.
+void UniformGrid::countFirstCells(std::span<const KeyBox> boxes, Part& part) {
+  const std::span<const KeyBox> mine = boxes.subspan(part.begin, part.end - part.begin);
   // Grow only: value-initialising the tail again every frame would cost a pass.
-  if (firstCell_.size() < boxes.size()) {
-    firstCell_.resize(boxes.size());
-    straddlers_.resize(boxes.size());
-    straddlerRanges_.resize(boxes.size());
+  if (part.straddlers.size() < mine.size()) {
+    part.straddlers.resize(mine.size());
+    part.ranges.resize(mine.size());
   }
   // Locals: the loop's stores cannot be seen to leave the members alone.
-  const FirstCells<Range> out{offsets_.data(), firstCell_.data(), straddlers_.data(), straddlerRanges_.data(),
-                              axes_[0].cells(), axes_[1].cells()};
+  const FirstCells<Range> out{part.firstCounts.data(), firstCell_.data() + part.begin, part.straddlers.data(),
+                              part.ranges.data(), axes_[0].cells(), axes_[1].cells()};
   std::size_t i = 0, straddling = 0;
 #if defined(__x86_64__)
-  i = firstCellsVector(boxes, axes_, out, straddling);
+  i = firstCellsVector(mine, axes_, out, straddling);
 #endif
-  for (; i < boxes.size(); ++i) {
+  for (; i < mine.size(); ++i) {
     std::array<std::uint32_t, 6> c;
     for (int a = 0; a < 3; ++a) {
-      c[a] = axes_[a].cellOf(boxes[i].min[a]);
-      c[a + 3] = axes_[a].cellOf(boxes[i].max[a]);
+      c[a] = axes_[a].cellOf(mine[i].min[a]);
+      c[a + 3] = axes_[a].cellOf(mine[i].max[a]);
     }
     straddling = out.record(i, c.data(), straddling);
   }
-  straddling_ = straddling;
+  part.straddling = straddling;
 }
 
-// The straddlers' other cells, within the cap on entries, listed first
-// (stores to consecutive slots, branch-free for nearly all), then counted.
-bool UniformGrid::countOtherCells(std::size_t boxCount) {
+// The part's straddlers' other cells, listed first (stores to consecutive
+// slots, branch-free for nearly all), then counted. False once the part
+// alone holds more than `cap` entries (the whole scene's cap: the work
+// before a fallback stays bounded, and the decision is the serial one's).
+bool UniformGrid::countOtherCells(Part& part, std::uint64_t cap) {
   const std::uint64_t nx = axes_[0].cells(), ny = axes_[1].cells();
-  std::uint64_t* const counts = offsets_.data();
-  const std::uint32_t* const straddlers = straddlers_.data();
-  const Range* const ranges = straddlerRanges_.data();
-  const std::uint64_t cap = kMaxEntriesPerBox * boxCount;
-  std::uint64_t entries = boxCount;
+  std::uint64_t* const counts = part.extraCounts.data();
+  const std::uint32_t* const straddlers = part.straddlers.data();
+  const Range* const ranges = part.ranges.data();
+  const auto base = static_cast<std::uint32_t>(part.begin);  // straddlers are listed by their place in the part
+  std::uint64_t entries = part.end - part.begin;
   std::size_t extra = 0;
+  std::vector<Extra>& extras = part.extras;
 #if defined(__x86_64__)
   const JoinTable table = joinTable<Extra>(nx, ny);
 #endif
-  for (std::size_t k = 0; k < straddling_; ++k) {
+  for (std::size_t k = 0; k < part.straddling; ++k) {
     const Range& r = ranges[k];
+    const std::uint32_t id = base + straddlers[k];
 #if defined(__x86_64__)
     const unsigned dx = r.last[0] - r.first[0], dy = r.last[1] - r.first[1], dz = r.last[2] - r.first[2];
     if ((dx | dy | dz) <= 1) {
       const unsigned p = dx | dy << 1 | dz << 2;
       entries += table.joined[p];
       if (entries > cap) return false;
-      if (extras_.size() < extra + 7) extras_.resize(2 * extra + 16);
-      const std::uint64_t base = (std::uint64_t{r.first[2]} * ny + r.first[1]) * nx + r.first[0];
-      const __m128i at = _mm_set_epi64x(static_cast<long long>(straddlers[k]), static_cast<long long>(base));
-      auto* const slots = reinterpret_cast<__m128i*>(extras_.data() + extra);
+      if (extras.size() < extra + 7) extras.resize(2 * extra + 16);
+      const std::uint64_t first = (std::uint64_t{r.first[2]} * ny + r.first[1]) * nx + r.first[0];
+      const __m128i at = _mm_set_epi64x(static_cast<long long>(id), static_cast<long long>(first));
+      auto* const slots = reinterpret_cast<__m128i*>(extras.data() + extra);
       for (unsigned j = 0; j < 7; ++j) _mm_storeu_si128(slots + j, _mm_add_epi64(at, table.joins[p][j]));
       extra += table.joined[p];
       continue;
@@ -482,22 +483,22 @@ bool UniformGrid::countOtherCells(std::size_t boxCount) {
     entries += others;
     if (entries > cap) return false;
     // Room for every slot written, the seven of the branch-free path included.
-    if (extras_.size() < extra + std::max<std::uint64_t>(others, 7)) extras_.resize(2 * (extra + others) + 8);
-    Extra* const slots = extras_.data();
-    const std::uint32_t id = straddlers[k];
+    if (extras.size() < extra + std::max<std::uint64_t>(others, 7)) extras.resize(2 * (extra + others) + 8);
+    Extra* const slots = extras.data();
     forEachOtherCell(r, nx, ny, [&](std::uint64_t cell, unsigned inside, unsigned below) {
       slots[extra] = {cell, id, static_cast<std::uint8_t>(below)};
       extra += inside;
     });
   }
-  extraCount_ = extra;
-  for (const Extra& e : std::span<const Extra>(extras_).first(extraCount_)) ++counts[e.cell];
+  part.extraCount = extra;
+  part.entries = entries;
+  for (const Extra& e : std::span<const Extra>(extras).first(extra)) ++counts[e.cell];
   return true;
 }
 
 void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, const CellSink& onCell,
                         const KeyBounds* bounds) {
-  if (!place(boxes, cellSize, bounds)) {
+  if (!place(boxes, cellSize, bounds, nullptr)) {
     fallback_.build(boxes, cellSize, onCell);
     return;
   }
@@ -509,7 +510,7 @@ void UniformGrid::build(std::span<const KeyBox> boxes, std::size_t cellSize, con
 
 void UniformGrid::buildInSteps(std::span<const KeyBox> boxes, std::size_t cellSize, const StepSink& onStep,
                                const KeyBounds* bounds) {
-  if (!place(boxes, cellSize, bounds)) {
+  if (!place(boxes, cellSize, bounds, nullptr)) {
     fallback_.build(boxes, cellSize, {});
     if (onStep) onStep(fallback_.cells().size());
     return;
@@ -521,60 +522,99 @@ void UniformGrid::buildInSteps(std::span<const KeyBox> boxes, std::size_t cellSi
   }
 }
 
-bool UniformGrid::place(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds* bounds) {
+void UniformGrid::buildIndex(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds* bounds,
+                             ThreadPool* pool) {
+  if (!place(boxes, cellSize, bounds, pool)) fallback_.build(boxes, cellSize, {});
+}
+
+bool UniformGrid::place(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds* bounds,
+                        ThreadPool* pool) {
   checkObjectCount(boxes.size());
   if (cellSize < 1) cellSize = 1;
   cells_.clear();
+  gathered_ = false;
   chooseResolution(boxes, cellSize, bounds ? *bounds : boundsOf(boxes));
-  const std::uint32_t nx = axes_[0].cells(), ny = axes_[1].cells(), nz = axes_[2].cells();
-  const std::size_t cellCount = std::size_t{nx} * ny * nz;
-  offsets_.assign(cellCount, 0);
-  fellBack_ = !countBoxes(boxes);
+  const std::size_t cellCount = std::size_t{axes_[0].cells()} * axes_[1].cells() * axes_[2].cells();
+  if (firstCell_.size() < boxes.size()) firstCell_.resize(boxes.size());
+  ThreadPool serial(1);
+  ThreadPool& threads = pool ? *pool : serial;
+  parts_.resize(threads.partsOf(boxes.size()));
+  std::vector<char> fits(parts_.size(), 0);
+  const std::uint64_t cap = kMaxEntriesPerBox * boxes.size();
+  threads.forParts(boxes.size(), [&](std::size_t k, std::size_t begin, std::size_t end) {
+    Part& part = parts_[k];
+    part.begin = begin;
+    part.end = end;
+    part.firstCounts.assign(cellCount, 0);
+    part.extraCounts.assign(cellCount, 0);
+    countFirstCells(boxes, part);
+    fits[k] = countOtherCells(part, cap);
+  });
+  std::uint64_t entries = 0;
+  for (std::size_t k = 0; k < parts_.size(); ++k) entries += fits[k] ? parts_[k].entries : cap + 1;
+  fellBack_ = entries > cap;
   if (fellBack_) return false;
-  // Prefix sum: each cell's count becomes its first item.
-  std::uint64_t total = 0;
-  cells_.reserve(cellCount);
-  for (std::uint32_t z = 0; z < nz; ++z)
-    for (std::uint32_t y = 0; y < ny; ++y)
-      for (std::uint32_t x = 0; x < nx; ++x) {
-        std::uint64_t& at = offsets_[(std::uint64_t{z} * ny + y) * nx + x];
-        const std::uint64_t count = at;
-        at = total;
-        cells_.push_back({total,
-                          static_cast<std::uint32_t>(count),
-                          {axes_[0].planes[x], axes_[1].planes[y], axes_[2].planes[z]},
-                          {axes_[0].planes[x + 1], axes_[1].planes[y + 1], axes_[2].planes[z + 1]}});
-        total += count;
-      }
+  const std::uint64_t total = placeCells();
   items_.resize(total);
   itemBelow_.resize(total);
   packed_.resize(total);
-  // Scatter (offsets_ becomes the cursor): every box into its first cell
-  // (below no axis there), then the straddlers into their others.
-  std::uint64_t* const cursor = offsets_.data();
+  threads.forParts(boxes.size(), [&](std::size_t k, std::size_t, std::size_t) { scatter(parts_[k]); });
+  return true;
+}
+
+// Each cell's place in the item list: its first cells part by part, then its
+// other cells part by part (the order one part alone would give). The
+// counters become the parts' cursors.
+std::uint64_t UniformGrid::placeCells() {
+  const std::uint32_t nx = axes_[0].cells(), ny = axes_[1].cells(), nz = axes_[2].cells();
+  std::uint64_t total = 0;
+  cells_.reserve(std::size_t{nx} * ny * nz);
+  for (std::uint32_t z = 0; z < nz; ++z)
+    for (std::uint32_t y = 0; y < ny; ++y)
+      for (std::uint32_t x = 0; x < nx; ++x) {
+        const std::uint64_t c = (std::uint64_t{z} * ny + y) * nx + x, start = total;
+        for (Part& part : parts_) {
+          const std::uint64_t count = part.firstCounts[c];
+          part.firstCounts[c] = total;
+          total += count;
+        }
+        for (Part& part : parts_) {
+          const std::uint64_t count = part.extraCounts[c];
+          part.extraCounts[c] = total;
+          total += count;
+        }
+        cells_.push_back({start,
+                          static_cast<std::uint32_t>(total - start),
+                          {axes_[0].planes[x], axes_[1].planes[y], axes_[2].planes[z]},
+                          {axes_[0].planes[x + 1], axes_[1].planes[y + 1], axes_[2].planes[z + 1]}});
+      }
+  return total;
+}
+
+// A part's boxes into their first cells (below no axis there), then its
+// straddlers into their others.
+void UniformGrid::scatter(Part& part) {
+  std::uint64_t* const cursor = part.firstCounts.data();
   std::uint32_t* const items = items_.data();
   std::uint8_t* const below = itemBelow_.data();
   const std::uint32_t* const firsts = firstCell_.data();
-  // A box in its first cell lies below it on no axis: those bits are cleared
-  // in one sweep, not written one by one beside the items.
-  std::fill(below, below + total, std::uint8_t{0});
-  // Touched in order first: the scatter's stores land at random, and on lines
-  // a frame's other work evicted each one missed alone (frame_timing --evict,
-  // 8000 boxes, grid 64: the build's median 107 -> 96 us); the stream of
-  // writes here is one the hardware prefetches.
-  std::fill(items, items + total, std::uint32_t{0});
-  for (std::size_t i = 0; i < boxes.size(); ++i) items[cursor[firsts[i]]++] = static_cast<std::uint32_t>(i);
-  for (const Extra& e : std::span<const Extra>(extras_).first(extraCount_)) {
-    const std::uint64_t at = cursor[e.cell]++;
+  for (std::size_t i = part.begin; i < part.end; ++i) {
+    const std::uint64_t at = cursor[firsts[i]]++;
+    items[at] = static_cast<std::uint32_t>(i);
+    below[at] = 0;
+  }
+  std::uint64_t* const extraCursor = part.extraCounts.data();
+  for (const Extra& e : std::span<const Extra>(part.extras).first(part.extraCount)) {
+    const std::uint64_t at = extraCursor[e.cell]++;
     items[at] = e.id;
     below[at] = e.below;
   }
-  return true;
 }
 
 // Writing the boxes in order is cheaper than scattering them with their
 // indices (one cache line filled at a time).
 void UniformGrid::gather(std::span<const KeyBox> boxes, std::size_t from, std::size_t to) {
+  gathered_ = true;
   if (from == to) return;
   const std::uint32_t* const items = items_.data();
   KeyBox* const packed = packed_.data();

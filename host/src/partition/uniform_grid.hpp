@@ -12,6 +12,34 @@
 
 namespace bpaccel {
 
+/// The grid's build state, outside the class so that it reads as data.
+namespace grid_build {
+
+struct Range {
+  std::array<std::uint16_t, 3> first, last;  // cells per axis (at most UniformGrid::kMaxCellsPerAxis)
+};
+// A straddler's entry in one of its other cells.
+struct Extra {
+  std::uint64_t cell;
+  std::uint32_t id;
+  std::uint8_t below;  // the box's below() bits in that cell
+};
+// One thread's share of a build: the boxes [begin, end), and per cell how
+// many of them have it as first cell and how many other entries its
+// straddlers put there (then the cursors of the scatter).
+struct Part {
+  std::size_t begin = 0, end = 0;
+  std::vector<std::uint64_t> firstCounts, extraCounts;
+  std::vector<std::uint32_t> straddlers;  // boxes in more than one cell (place in the part), with their ranges
+  std::vector<Range> ranges;
+  std::size_t straddling = 0;             // how many of those two hold this frame's straddlers
+  std::vector<Extra> extras;              // the straddlers' entries in their other cells
+  std::size_t extraCount = 0;             // how many of those this frame holds
+  std::uint64_t entries = 0;              // the part's boxes and their extra entries
+};
+
+}  // namespace grid_build
+
 /// A counting sort of the boxes into the cells of a grid: one pass finds each
 /// box's range of cells and counts the cells' boxes, a prefix sum places the
 /// cells, a second pass scatters the boxes' indices. A box that straddles
@@ -72,14 +100,19 @@ class UniformGrid final : public Partition {
   bool needsBounds() const override { return true; }
   void buildInSteps(std::span<const KeyBox> boxes, std::size_t cellSize, const StepSink& onStep,
                     const KeyBounds* bounds = nullptr) override;
+  /// The cells and their items and bits, counted and placed on the pool's
+  /// threads (each a contiguous part of the boxes, the same cells and items
+  /// in the same order as on one), without packing the boxes.
+  void buildIndex(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds* bounds,
+                  ThreadPool* pool) override;
   const std::vector<Cell>& cells() const override { return fellBack_ ? fallback_.cells() : cells_; }
   std::span<const std::uint32_t> items(const Cell& cell) const override {
     if (fellBack_) return fallback_.items(cell);
     return {items_.data() + cell.begin, cell.count};
   }
-  /// The cells' boxes in the device's layout, like items(cell) (empty after a fallback).
+  /// The cells' boxes in the device's layout, like items(cell) (empty after a fallback or buildIndex).
   std::span<const KeyBox> packed(const Cell& cell) const override {
-    if (fellBack_) return {};
+    if (fellBack_ || !gathered_) return {};
     return {packed_.data() + cell.begin, cell.count};
   }
   /// Known without comparing keys: a box's first cell (its min's) lies at or
@@ -98,8 +131,11 @@ class UniformGrid final : public Partition {
   std::array<std::uint32_t, 3> resolution() const;
   /// Item entries the grid's buffers hold (their capacity).
   std::size_t storedItems() const {
-    return items_.capacity() + itemBelow_.capacity() + offsets_.capacity() + firstCell_.capacity() +
-           straddlers_.capacity() + straddlerRanges_.capacity() + extras_.capacity();
+    std::size_t n = items_.capacity() + itemBelow_.capacity() + firstCell_.capacity();
+    for (const Part& p : parts_)
+      n += p.firstCounts.capacity() + p.extraCounts.capacity() + p.straddlers.capacity() + p.ranges.capacity() +
+           p.extras.capacity();
+    return n;
   }
   /// Boxes the grid's packed copy holds (its capacity).
   std::size_t storedBoxes() const { return packed_.capacity(); }
@@ -115,40 +151,30 @@ class UniformGrid final : public Partition {
     std::uint32_t cellOf(std::uint32_t key) const;
     void place(std::uint32_t keyLo, std::uint32_t keyHi, std::uint32_t cells);
   };
-  struct Range {
-    std::array<std::uint16_t, 3> first, last;  // cells per axis (at most kMaxCellsPerAxis)
-  };
-  // Counts each cell's boxes into offsets_; false when the boxes would join too many cells.
-  bool countBoxes(std::span<const KeyBox> boxes);
-  void countFirstCells(std::span<const KeyBox> boxes);  // every box's first cell; the straddlers listed
-  bool countOtherCells(std::size_t boxCount);          // the straddlers' other cells, within the cap
+  using Range = grid_build::Range;
+  using Extra = grid_build::Extra;
+  using Part = grid_build::Part;
+  void countFirstCells(std::span<const KeyBox> boxes, Part& part);  // first cells; the straddlers listed
+  bool countOtherCells(Part& part, std::uint64_t cap);               // the straddlers' other cells, within the cap
   // Resolution, counts, cells and every item placed with its bits; false
   // when the grid falls back to the tree (fellBack_), which is then not built.
-  bool place(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds* bounds);
+  bool place(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds* bounds, ThreadPool* pool);
+  std::uint64_t placeCells();  // the cells from the parts' counts; returns the items' total
+  void scatter(Part& part);
   // The boxes of cells [from, to) gathered in cell order (packed_).
   void gather(std::span<const KeyBox> boxes, std::size_t from, std::size_t to);
   void chooseResolution(std::span<const KeyBox> boxes, std::size_t cellSize, const KeyBounds& bounds);
-  // A straddler's entry in one of its other cells.
-  struct Extra {
-    std::uint64_t cell;
-    std::uint32_t id;
-    std::uint8_t below;  // the box's below() bits in that cell
-  };
 
   std::array<Axis, 3> axes_;
   std::vector<std::uint32_t> firstCell_;  // each box's first cell (its min corner's)
-  std::vector<std::uint32_t> straddlers_;  // boxes in more than one cell, with their ranges
-  std::vector<Range> straddlerRanges_;
-  std::size_t straddling_ = 0;            // how many of those two hold this frame's straddlers
-  std::vector<Extra> extras_;             // the straddlers' entries in their other cells
-  std::size_t extraCount_ = 0;            // how many of those this frame holds
-  std::vector<std::uint64_t> offsets_;   // per cell: its count, then its first item, then the scatter cursor
+  std::vector<Part> parts_;
   std::vector<std::uint32_t> items_;     // the cells' item lists, in cell order
   std::vector<std::uint8_t> itemBelow_;  // each item's below() bits, in the same order
   std::vector<KeyBox> packed_;           // their boxes, in the same order
   std::vector<Cell> cells_;
   KdTree fallback_;
   bool fellBack_ = false;
+  bool gathered_ = false;                // packed_ holds this build's boxes
 };
 
 }  // namespace bpaccel

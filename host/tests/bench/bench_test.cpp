@@ -209,8 +209,8 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
   for (const auto& row : j["rows"]) {
     EXPECT_TRUE(row.contains("exact_pairs_per_frame_mean"));
     EXPECT_FALSE(row["fastest_baseline"].is_null());
-    // Bullet 3, FCL 3, CGAL 1, ODE 2, then accelerator and cpu per cell size, k-d and grid.
-    ASSERT_EQ(row["methods"].size(), 3u + 3u + 1u + 2u + (3u + 1u) + (3u + 1u));
+    // Bullet 3, FCL 3, CGAL 1, ODE 2, then accelerator and cpu per cell size, k-d and grid, and cpu auto.
+    ASSERT_EQ(row["methods"].size(), 3u + 3u + 1u + 2u + (3u + 1u) + (3u + 1u) + 1u);
     std::set<std::string> gridRows;
     for (const auto& m : row["methods"])
       if (m.value("partition", "") == "grid") gridRows.insert(m["name"]);
@@ -695,17 +695,39 @@ TEST(Benchmark, AMethodSlowerThanTheLimitIsStoppedAndListedWithItsTime) {
   }
 }
 
-TEST(Benchmark, TheCpuBackendAlsoRunsOnSeveralThreadsExactly) {
+namespace {
+
+// The cpu rows of the first row whose name contains `part`, each checked exact; their names.
+std::vector<std::string> exactCpuRowsNamed(std::size_t cpuThreads, const std::string& part) {
   auto l = tinyLineUp();
-  l.cpuThreads = 2;
+  l.cpuThreads = cpuThreads;
   const auto j = runQuietly(tinyConfig(), standardLineUp(l), l);
-  std::size_t threaded = 0;
+  std::vector<std::string> names;
   for (const auto& m : j["rows"][0]["methods"])
-    if (m["name"].get<std::string>().find(", 2 threads") != std::string::npos) {
-      ++threaded;
-      EXPECT_EQ(m["kind"], "cpu");
-      EXPECT_EQ(m["missing_pairs"], 0);
-      EXPECT_EQ(m["extra_pairs"], 0);
+    if (m["name"].get<std::string>().find(part) != std::string::npos) {
+      names.push_back(m["name"]);
+      EXPECT_EQ(m["kind"], "cpu") << names.back();
+      EXPECT_EQ(m["missing_pairs"], 0) << names.back();
+      EXPECT_EQ(m["extra_pairs"], 0) << names.back();
     }
-  EXPECT_EQ(threaded, 2u);  // cell sizes 4 and 16; none has one cell to share
+  return names;
+}
+
+}  // namespace
+
+TEST(Benchmark, TheCpuBackendAlsoRunsOnSeveralThreadsExactly) {
+  // Cell sizes 4 and 16 (none has one cell to share), and the automatic choice.
+  EXPECT_EQ(exactCpuRowsNamed(2, ", 2 threads"),
+            (std::vector<std::string>{"cpu k-d 4, 2 threads", "cpu k-d 16, 2 threads", "cpu auto, 2 threads"}));
+}
+
+TEST(Benchmark, TheCpuBackendsAutomaticChoiceRunsExactlyBesideTheFixedOnes) {
+  EXPECT_EQ(exactCpuRowsNamed(1, "cpu auto"), std::vector<std::string>{"cpu auto"});
+  auto l = tinyLineUp();
+  l.cpuThreads = 1;
+  for (const auto& m : runQuietly(tinyConfig(), standardLineUp(l), l)["rows"][0]["methods"])
+    if (m["name"] == "cpu auto") {
+      EXPECT_EQ(m["cell_size"], "auto");
+      EXPECT_EQ(m["partition"], "auto");
+    }
 }

@@ -10,6 +10,8 @@
 #include <set>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include "bpaccel_params.h"
 #include "broad_phase/broad_phase.hpp"
 #include "core/keys.hpp"
@@ -586,3 +588,71 @@ TEST(BroadPhase, NarrowKeyDevicesGiveExactlyTheFullKeyPairs) {
   EXPECT_GE(hits[16], hits[32]);
 }
 
+
+TEST(BroadPhase, TheCpuBackendRunsItsCellsOnTheHostExactlyForEveryPartitionCellSizeAndThreadCount) {
+  std::vector<std::unique_ptr<BroadPhase>> phases;
+  std::vector<std::string> labels;
+  for (std::size_t threads : {1u, 2u})
+    for (PartitionKind kind : {PartitionKind::KdTree, PartitionKind::UniformGrid, PartitionKind::Automatic})
+      for (CellSize cell : {CellSize(std::nullopt), CellSize(1), CellSize(8), CellSize(200), CellSize::automatic()}) {
+        phases.push_back(std::make_unique<BroadPhase>([] { return std::make_unique<CpuBackend>(); },
+                                                      BroadPhaseConfig{.cellSize = cell, .partition = kind, .threads = threads}));
+        EXPECT_EQ(phases.back()->threads(), threads);
+        labels.push_back(fmt::format("{} cell {} threads {}", partitionName(kind), cell.name(), threads));
+      }
+  for (std::size_t n : {0u, 1u, 97u, 400u})
+    for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 21)) {
+      const auto exact = bruteForce(boxes);
+      for (std::size_t k = 0; k < phases.size(); ++k) {
+        std::vector<Pair> pairs{{1, 2}};  // cleared first
+        phases[k]->findPairs(boxes, pairs);
+        EXPECT_EQ(sorted(pairs), exact) << name << " n=" << n << " " << labels[k];
+        EXPECT_EQ(phases[k]->stats().hits, pairs.size()) << labels[k];
+      }
+    }
+}
+
+TEST(BroadPhase, TheAutomaticChoiceIsOneCellForSmallScenesAndAPartitionAbove) {
+  const auto cpu = [] { return std::make_unique<CpuBackend>(); };
+  const auto small = scatteredBoxes(AutomaticChoice::kOneCellUpTo, 1, 0, 10, 0.5f, 2);
+  const auto large = scatteredBoxes(AutomaticChoice::kOneCellUpTo + 1, 1, 0, 10, 0.5f, 2);
+  std::vector<Pair> pairs;
+  BroadPhase automatic(cpu, {});
+  automatic.findPairs(small, pairs);
+  EXPECT_EQ(automatic.choice(), (CellChoice{PartitionKind::UniformGrid, std::nullopt}));
+  automatic.findPairs(large, pairs);
+  EXPECT_EQ(automatic.choice(), (CellChoice{PartitionKind::UniformGrid, AutomaticChoice::kFirstCellSize}));
+  // A partition named: only the cell size is chosen, for every scene size.
+  BroadPhase tree(cpu, {.partition = PartitionKind::KdTree});
+  tree.findPairs(small, pairs);
+  EXPECT_EQ(tree.choice(), (CellChoice{PartitionKind::KdTree, AutomaticChoice::kFirstCellSize}));
+  // A cell size given alone means the k-d tree, as it always has.
+  BroadPhase sized(cpu, {.cellSize = 32});
+  sized.findPairs(large, pairs);
+  EXPECT_EQ(sized.choice(), (CellChoice{PartitionKind::KdTree, 32}));
+  EXPECT_EQ(choiceName(sized.choice()), "k-d 32");
+  EXPECT_EQ(choiceName(automatic.choice()), "grid 64");
+  EXPECT_EQ(choiceName({PartitionKind::UniformGrid, std::nullopt}), "one cell");
+}
+
+TEST(BroadPhase, TheAutomaticChoiceIsExactOnADevice) {
+  ModelBackend model(DeviceParams::seed(2, 6, 5));
+  BroadPhase bp(model, {});
+  for (std::size_t n : {50u, 700u})
+    for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 2)) {
+      std::vector<Pair> pairs;
+      bp.findPairs(boxes, pairs);
+      EXPECT_EQ(sorted(pairs), bruteForce(boxes)) << name << " n=" << n << " " << choiceName(bp.choice());
+    }
+}
+
+TEST(BroadPhaseConfig, CellSizeIsAutomaticByDefaultAndParsesPartitionAuto) {
+  EXPECT_TRUE(BroadPhaseConfig{}.cellSize.isAutomatic());
+  EXPECT_EQ(BroadPhaseConfig{}.partition, PartitionKind::Automatic);
+  EXPECT_THROW(CellSize::automatic().fixed(), std::logic_error);
+  EXPECT_EQ(CellSize(64).fixed(), std::optional<std::size_t>{64});
+  EXPECT_EQ(CellSize(std::nullopt).name(), "none");
+  EXPECT_EQ(CellSize::automatic().name(), "auto");
+  EXPECT_EQ(parsePartitionKind("auto"), PartitionKind::Automatic);
+  EXPECT_THROW(parsePartitionKind("octree"), std::invalid_argument);
+}

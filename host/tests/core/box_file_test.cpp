@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <random>
 #include <sstream>
+#include <vector>
 
 #include "core/box_file.hpp"
 
@@ -90,3 +92,29 @@ TEST(ReadBoxes, AcceptsTheLargestFloatAndRejectsBeyondItNamingTheField) {
 TEST(ReadBoxes, RejectsNaN) { EXPECT_EQ(errorOf("\n\nnan 0 0 1 1 1\n"), "line 3: minx is NaN"); }
 
 TEST(ReadBoxes, RejectsMinAboveMax) { EXPECT_EQ(errorOf("0 2 0 1 1 1\n"), "line 1: miny 2 > maxy 1"); }
+
+TEST(WriteBoxes, WritesBoxesThatReadBackBitForBit) {
+  const float tiny = std::numeric_limits<float>::denorm_min(), big = std::numeric_limits<float>::max();
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<Aabb> boxes = {{{-0.0f, 1e-30f, -inf}, {0.0f, 0.1f, inf}},
+                             {{tiny, -big, 1.0f / 3}, {2 * tiny, big, 3.4e37f}}};
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> any(-1e6f, 1e6f);
+  for (int k = 0; k < 3000; ++k) {  // more than one write of the buffer
+    Aabb b;
+    for (int a = 0; a < 3; ++a) {
+      b.min[a] = any(rng);
+      b.max[a] = b.min[a] + std::abs(any(rng));
+    }
+    boxes.push_back(b);
+  }
+  std::stringstream text;
+  writeBoxes(text, boxes);
+  const std::vector<Aabb> back = readBoxes(text);
+  ASSERT_EQ(back.size(), boxes.size());
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_EQ(std::bit_cast<std::uint32_t>(back[i].min[a]), std::bit_cast<std::uint32_t>(boxes[i].min[a])) << i;
+      EXPECT_EQ(std::bit_cast<std::uint32_t>(back[i].max[a]), std::bit_cast<std::uint32_t>(boxes[i].max[a])) << i;
+    }
+}

@@ -14,6 +14,7 @@
 #include "core/keys.hpp"
 #include "scenes.hpp"
 #include "partition/uniform_grid.hpp"
+#include "core/thread_pool.hpp"
 
 using namespace bpaccel;
 using namespace bpaccel::testing;
@@ -479,4 +480,33 @@ TEST(Partition, KindsParseFromTheCliSpellingAndRejectOthers) {
   EXPECT_THROW(parsePartitionKind("octree"), std::invalid_argument);
   EXPECT_EQ(makePartition(PartitionKind::UniformGrid)->name(), "grid");
   EXPECT_EQ(makePartition(PartitionKind::KdTree)->name(), "k-d");
+}
+
+TEST(UniformGrid, BuildIndexOnTwoThreadsGivesTheCellsItemsAndBitsOfABuildOnOne) {
+  ThreadPool pool(2);
+  std::size_t gridded = 0;
+  for (std::size_t n : {1, 2, 3, 300, 2000})
+    for (const auto& [name, boxes] : adversarialScenes(n, static_cast<unsigned>(n) + 2))
+      for (std::size_t cell : {2u, 16u, 64u}) {
+        const std::vector<KeyBox> keys = keysOf(boxes);
+        UniformGrid serial, parallel;
+        serial.build(keys, cell, {});
+        parallel.buildIndex(keys, cell, nullptr, &pool);
+        const std::string label = name + " n=" + std::to_string(n) + " cell " + std::to_string(cell);
+        ASSERT_EQ(parallel.fellBack(), serial.fellBack()) << label;
+        ASSERT_EQ(parallel.cells().size(), serial.cells().size()) << label;
+        for (std::size_t c = 0; c < serial.cells().size(); ++c) {
+          const Cell &a = serial.cells()[c], &b = parallel.cells()[c];
+          ASSERT_EQ(b.lo, a.lo) << label << " cell " << c;
+          ASSERT_EQ(b.hi, a.hi) << label << " cell " << c;
+          const auto ia = serial.items(a), ib = parallel.items(b);
+          ASSERT_TRUE(std::equal(ia.begin(), ia.end(), ib.begin(), ib.end())) << label << " cell " << c;
+          const auto ba = serial.below(a), bb = parallel.below(b);
+          ASSERT_TRUE(std::equal(ba.begin(), ba.end(), bb.begin(), bb.end())) << label << " cell " << c;
+        }
+        if (parallel.fellBack()) continue;
+        ++gridded;
+        if (!serial.cells().empty()) EXPECT_TRUE(parallel.packed(parallel.cells().front()).empty()) << label;
+      }
+  EXPECT_GE(gridded, 30u) << "most scenes should be gridded, not handed to the tree";
 }
