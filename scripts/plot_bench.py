@@ -29,14 +29,14 @@ def platforms(cfg):
     profiles = cfg.get("profiles") or []
     if not profiles:
         return f"{cfg.get('clock_hz', 0) / 1e6:.0f} MHz"
-    return "; ".join(f"{p['name']}: {p['part']['name']} {p['part']['clock_hz']['value'] / 1e6:.0f} MHz "
+    return "\n".join(f"{p['name']}: {p['part']['name']} {p['part']['clock_hz']['value'] / 1e6:.0f} MHz "
                      f"({p['part']['clock_hz']['provenance']}), {p['link']['generation']} "
                      f"{p['link']['effective_bytes_per_second_each_way']['value'] / 1e9:.2f} GB/s "
                      f"({p['link']['effective_bytes_per_second_each_way']['provenance']})" for p in profiles)
 
 
 def plot_acceleration(rows, cfg, out):
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = plt.subplots(figsize=(7, 5))
     counts = [r["objects"] for r in rows]
     series = [("cpu", "", "--s")] + [("accelerator", p, "-o") for p in
                                       sorted({profile_of(m) for r in rows for m in r["methods"]
