@@ -18,5 +18,13 @@ object BinningFault {
   /** The serializer drops its head beat after the first pair: a beat's other pairs are lost. */
   case object SerializerDropsBeat extends BinningFault("the serializer drops a beat after its first pair")
 
-  val all: Seq[BinningFault] = Seq(StrictCompare, NoExactlyOnceRule, LaneMaskOneTooWide, SerializerDropsBeat)
+  /** A merge cluster takes a group's pair while its queue is full: the pair is lost. */
+  case object ClusterTakesWhenFull extends BinningFault("a merge cluster takes a pair while its queue is full")
+  /** The intake's grid check lets a key through whose cell equals the dimension (> instead of >=). */
+  case object OutOfGridOffByOne extends BinningFault("the intake lets a key one cell past the grid through")
+  /** The intake counts boxes offered, not taken: a host's pause miscounts them. */
+  case object ReceivedCountsOffers extends BinningFault("the intake counts boxes offered instead of taken")
+
+  val all: Seq[BinningFault] = Seq(StrictCompare, NoExactlyOnceRule, LaneMaskOneTooWide, SerializerDropsBeat,
+    ClusterTakesWhenFull, OutOfGridOffByOne, ReceivedCountsOffers)
 }

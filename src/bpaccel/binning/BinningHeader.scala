@@ -35,6 +35,7 @@ object BinningHeader {
       num("CELL_QUEUE_DEPTH", p.cellQueueDepth),
       num("ITEM_QUEUE_DEPTH", p.itemQueueDepth),
       num("HIT_QUEUE_DEPTH", p.hitQueueDepth),
+      num("MERGE_QUEUE_DEPTH", p.mergeQueueDepth),
       num("HIT_LATENCY", p.hitLatency),
       num("COUNTER_WIDTH", p.counterWidth),
       num("DEBUG_PORT", if (p.debugPort) 1 else 0),

@@ -64,6 +64,7 @@ object BinningErrorCode {
   * @param maskQueueDepth   intake beats queued per group
   * @param cellQueueDepth   cells the walker reads ahead of the reader, per group
   * @param hitQueueDepth    hit beats (one schedule cycle's hits) queued per group
+  * @param mergeQueueDepth  pairs each merge cluster queues, and beats the output queue holds
   * @param counterWidth     bits of the cycle counters (the formal checks narrow them)
   * @param debugPort        probes for the cycle-by-cycle comparison with the golden model
   * @param faults           deliberate bugs for the mutant tests; empty for every real build
@@ -83,6 +84,7 @@ case class BinningParams(
   maskQueueDepth: Int = 4,
   cellQueueDepth: Int = 4,
   hitQueueDepth: Int = 8,
+  mergeQueueDepth: Int = 2,
   counterWidth: Int = 64,
   debugPort: Boolean = false,
   faults: Set[BinningFault] = Set.empty
@@ -104,6 +106,7 @@ case class BinningParams(
   require(laneQueueDepth >= 1 && maskQueueDepth >= 1 && cellQueueDepth >= 1,
     s"queue depths must be at least 1, got lane $laneQueueDepth, mask $maskQueueDepth, cell $cellQueueDepth")
   require(hitQueueDepth >= 2, s"hitQueueDepth must be at least 2, got $hitQueueDepth")
+  require(mergeQueueDepth >= 2, s"mergeQueueDepth must be at least 2 (one pair or beat a cycle), got $mergeQueueDepth")
   require(counterWidth >= 4 && counterWidth <= 64, s"counterWidth must lie in 4..64, got $counterWidth")
 
   /** G: lane groups. */
@@ -180,6 +183,6 @@ case class BinningParams(
   def fingerprint: String =
     s"arch=binning,groups=${groupBits.mkString("x")},g=$g,key_width=$keyWidth,cell_bits=$cellBits," +
       s"boxes=$boxCapacity,group_entries=$groupCapacity,intake=$intakeBoxes,pairs=$pairsPerBeat," +
-      s"memstages=$memoryOutputStages,queues=$laneQueueDepth/$maskQueueDepth/$cellQueueDepth/$hitQueueDepth," +
+      s"memstages=$memoryOutputStages,queues=$laneQueueDepth/$maskQueueDepth/$cellQueueDepth/$hitQueueDepth/$mergeQueueDepth," +
       s"debug=${if (debugPort) 1 else 0}" + (if (memoryStyle != MemoryStyle.Inferred) s",memory=${memoryStyle.name}" else "")
 }

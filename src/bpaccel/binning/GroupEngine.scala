@@ -65,7 +65,8 @@ class GroupEngine(p: BinningParams) extends Module {
   when(bubble) { for (k <- 0 until g) a(k) := window(k).entry }
   when(issue && lane0.tags.nextBlock) { a := aNext }
   val top = window(g - 1)
-  when(issue && filled(g - 1) && top.tags.capture) { aNext(top.tags.captureLane) := top.entry }
+  for (k <- 0 until g)
+    when(issue && filled(g - 1) && top.tags.capture && ((g == 1).B || top.tags.captureLane === k.U)) { aNext(k) := top.entry }
 
   // ---- lanes: overlap on the clamped offsets and the exactly-once rule, registered twice ----
   class Compared extends Bundle {

@@ -36,7 +36,7 @@ object BoxCells {
     val hi = box.bits.max.map(_ >> shift)
     val lowMask  = ((1.U((p.keyWidth + 1).W) << shift) - 1.U)(p.localBits - 1, 0)
     val inverted = (0 until 3).map(a => box.bits.min(a) > box.bits.max(a)).reduce(_ || _)
-    val outside  = (0 until 3).map(a => hi(a) >= dims(a)).reduce(_ || _)
+    val outside  = (0 until 3).map(a => if (p.has(BinningFault.OutOfGridOffByOne)) hi(a) > dims(a) else hi(a) >= dims(a)).reduce(_ || _)
     val wide     = (0 until 3).map(a => hi(a) - lo(a) > 1.U).reduce(_ || _)
     d.error := MuxCase(BinningError.None, Seq(
       (index >= n) -> BinningError.LengthMismatch,
@@ -162,6 +162,7 @@ class Intake(p: BinningParams) extends Module {
   // ---- taking the next beat ----
   io.boxes.ready := io.active && !lastTaken && (!held || moves)
   val count = PopCount(io.boxes.bits.boxes.map(_.valid))
+  if (p.has(BinningFault.ReceivedCountsOffers)) when(io.boxes.valid && !io.boxes.ready) { received := received + count }
   when(io.boxes.fire) {
     for (l <- 0 until w)
       beat(l) := BoxCells(p, io.boxes.bits.boxes(l), received + l.U, io.n, io.shift, io.dims)

@@ -51,7 +51,7 @@ class RoundRobin(n: Int) extends Module {
 
 /** Merges the groups' pairs into beats of up to pairsPerBeat: cluster c
   * serves groups c, c + P, ... round robin, one pair a cycle into its queue
-  * of two; each cycle the output queue (two beats) takes the heads of all
+  * (mergeQueueDepth pairs); each cycle the output queue (as many beats) takes the heads of all
   * cluster queues at once, lowest cluster first in the beat's lowest lanes.
   */
 class PairMerge(p: BinningParams) extends Module {
@@ -65,16 +65,17 @@ class PairMerge(p: BinningParams) extends Module {
   val clusters = (0 until lanes).map { c =>
     val members = p.clusterGroups(c)
     val arbiter = Module(new RoundRobin(members.length))
-    val queue   = Module(new Queue(new BinPair(p), 2))
+    val queue   = Module(new Queue(new BinPair(p), p.mergeQueueDepth))
     arbiter.io.restart := io.restart
     arbiter.io.request := VecInit(members.map(io.groups(_).valid))
-    arbiter.io.take    := queue.io.enq.ready
-    queue.io.enq.valid := arbiter.io.grant.orR && queue.io.enq.ready
+    val room = if (p.has(BinningFault.ClusterTakesWhenFull)) true.B else queue.io.enq.ready
+    arbiter.io.take    := room
+    queue.io.enq.valid := arbiter.io.grant.orR && room
     queue.io.enq.bits  := Mux1H(arbiter.io.grant, members.map(io.groups(_).bits))
-    for ((gr, k) <- members.zipWithIndex) io.groups(gr).ready := queue.io.enq.ready && arbiter.io.grant(k)
+    for ((gr, k) <- members.zipWithIndex) io.groups(gr).ready := room && arbiter.io.grant(k)
     queue
   }
-  val output = Module(new Queue(new PairBeat(p), 2))
+  val output = Module(new Queue(new PairBeat(p), p.mergeQueueDepth))
   val heads  = clusters.map(_.io.deq)
   val offered = heads.map(_.valid)
   output.io.enq.valid := offered.reduce(_ || _)

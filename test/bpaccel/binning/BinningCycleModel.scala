@@ -53,9 +53,9 @@ import scala.collection.mutable
   *  - a group is done in the first cycle whose start has no item to come, an
   *    empty window and no issue in flight.
   * Merge: each cycle, cluster c (groups c, c+P, ...) moves the pair of the
-  * first offering group after its last grant into its queue of two unless it
-  * is full, and all cluster queues' heads move together into the output
-  * queue of two (lowest cluster first) unless it is full; io.pairs is its head.
+  * first offering group after its last grant into its queue unless it is
+  * full, and all cluster queues' heads move together into the output queue
+  * (lowest cluster first) unless it is full (both of mergeQueueDepth); io.pairs is its head.
   * The frame is finished in the first cycle whose start has every group done
   * and every queue of the output path empty. The summary is valid from the
   * next cycle: a frame finished in cycle t took t + 1 cycles.
@@ -177,8 +177,8 @@ object BinningCycleModel {
     // ---------------- output ----------------
     val clusters  = (0 until p.pairsPerBeat).map(p.clusterGroups)
     val lastGrant = Array.fill(p.pairsPerBeat)(-1)
-    val clusterQ  = Array.fill(p.pairsPerBeat)(new Fifo[(Int, Int)](2))
-    val outQ      = new Fifo[Seq[(Int, Int)]](2)
+    val clusterQ  = Array.fill(p.pairsPerBeat)(new Fifo[(Int, Int)](p.mergeQueueDepth))
+    val outQ      = new Fifo[Seq[(Int, Int)]](p.mergeQueueDepth)
     val beats     = Vector.newBuilder[BeatAt]
     var stalls    = 0L
     var finished  = -1L
