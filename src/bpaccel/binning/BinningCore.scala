@@ -11,13 +11,8 @@ import chisel3.util._
   * localCells cycles, before it takes the next header); nothing more is sent.
   */
 class BinningCore(val p: BinningParams) extends Module {
-  val io = IO(new Bundle {
-    val frame   = Flipped(Decoupled(new FrameHeader))
-    val boxes   = Flipped(Decoupled(new BoxBeat(p)))
-    val abort   = Input(Bool())
-    val pairs   = Decoupled(new PairBeat(p))
-    val summary = Decoupled(new FrameSummary(p))
-    val debug   = if (p.debugPort) Some(Output(Vec(p.groups, new GroupProbe(p)))) else None
+  val io = IO(new BinningPorts(p) {
+    val debug = if (p.debugPort) Some(Output(Vec(p.groups, new GroupProbe(p)))) else None
   })
   // An abort resets every register of the core (the memories keep their
   // contents; the cleared tables are all that the next frame relies on).

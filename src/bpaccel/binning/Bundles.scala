@@ -61,6 +61,17 @@ class FrameSummary(p: BinningParams) extends Bundle {
   val stallCycles  = UInt(p.counterWidth.W) // cycles pairs were offered and not taken
 }
 
+/** The binning core's ports to the stream shell (docs/binning.md): the
+  * frame's header and boxes in, abort, the pairs and the summary out.
+  */
+class BinningPorts(p: BinningParams) extends Bundle {
+  val frame   = Flipped(Decoupled(new FrameHeader))
+  val boxes   = Flipped(Decoupled(new BoxBeat(p)))
+  val abort   = Input(Bool())
+  val pairs   = Decoupled(new PairBeat(p))
+  val summary = Decoupled(new FrameSummary(p))
+}
+
 /** One box's entry in one cell of a group: its key offsets in the cell,
   * clamped to it (a box that starts in an earlier cell has min offset 0 there,
   * one that ends in a later cell max offset 2^shift - 1), whether it starts in

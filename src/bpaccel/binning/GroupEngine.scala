@@ -7,8 +7,10 @@ import chisel3.util._
   *
   * The window holds the next g stream items (lane 0 first); after each
   * schedule cycle's shift the item queue's head enters the lowest empty lane.
-  * A schedule cycle happens when lane 0 holds an item and all lanes do (or
-  * no item will come any more, `noMore`):
+  * A schedule cycle happens when the window holds every item it uses: lanes
+  * 0 .. min(left, g-1), left = n-1-p of lane 0's entry p (so no cell waits
+  * for the items of the cells after it). A block's next A objects pass the
+  * top lane only while left >= g-1, when all lanes are needed anyway:
   *  - lane 0 holds a cell's entry 0: a bubble, in which the A registers take
   *    the window's lanes (entries 0 .. g-1 of the cell; past n they are
   *    never compared);
@@ -26,7 +28,6 @@ class GroupEngine(p: BinningParams) extends Module {
   private val g = p.g
   val io = IO(new Bundle {
     val items   = Flipped(Decoupled(new StreamItem(p)))
-    val noMore  = Input(Bool())
     val hits    = Valid(new HitBeat(p))   // an issue's hits, when any lane hit
     val hitFreed = Input(Bool())          // the hit queue let a beat go
     val idle    = Output(Bool())          // the window is empty and no issue is in flight
@@ -43,7 +44,11 @@ class GroupEngine(p: BinningParams) extends Module {
   val credits = RegInit(p.hitQueueDepth.U(log2Ceil(p.hitQueueDepth + 1).W))
 
   val lane0   = window(0)
-  val ready   = filled(0) && (filled(g - 1) || io.noMore)
+  // Lane min(left, g-1), the highest it compares, holds an item (lanes fill from 0).
+  val usedFilled =
+    if (g == 1) true.B
+    else Mux(lane0.tags.left >= (g - 1).U, filled(g - 1), filled(lane0.tags.left(log2Ceil(g) - 1, 0)))
+  val ready   = filled(0) && usedFilled
   val bubble  = ready && lane0.tags.first
   val issue   = ready && !lane0.tags.first && credits =/= 0.U
   val shifts  = bubble || issue

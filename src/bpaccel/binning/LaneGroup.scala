@@ -86,7 +86,6 @@ class LaneGroup(p: BinningParams) extends Module {
   reader.io.entryData := entryMemory.io.readData.asTypeOf(new BinEntry(p))
   val noMore = walker.io.done && !walker.io.cells.valid && reader.io.idle
   engine.io.items <> reader.io.items
-  engine.io.noMore   := noMore
   engine.io.hitFreed := hits.io.freed
   hits.io.hits := engine.io.hits
   io.out <> hits.io.out

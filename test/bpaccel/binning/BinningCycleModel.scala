@@ -43,8 +43,10 @@ import scala.collection.mutable
   *    memoryReadLatency cycles after its read (order memory, entry memory);
   *  - the window holds up to g items; after the cycle's shift the item
   *    queue's head enters its lowest empty lane;
-  *  - a schedule cycle happens when lane 0 holds an item, all g lanes do or no
-  *    item will come any more, and either lane 0's item is a cell's entry 0
+  *  - a schedule cycle happens when the window holds every item it uses
+  *    (lanes 0 .. min(n-1-p, g-1), p lane 0's entry: the lanes it compares;
+  *    the successor block's A objects pass the top lane only while
+  *    n-1-p >= g-1), and either lane 0's item is a cell's entry 0
   *    (a bubble: the A registers take the window's lanes) or the hit queue's
   *    count plus the issues in flight is below its depth (an issue);
   *  - an issue's hits are queued hitLatency cycles later as one beat, if any
@@ -98,6 +100,7 @@ object BinningCycleModel {
   /** One stream item of a group: entry `p` of cell `cell` (n entries), streamed in block `block`. */
   private case class Item(cell: Int, p: Int, block: Int, n: Int) {
     def first: Boolean = block == 0 && p == 0
+    def left: Int = n - 1 - p
   }
 
   private def cellStream(cell: Int, n: Int, g: Int): Seq[Item] =
@@ -215,7 +218,7 @@ object BinningCycleModel {
           val noMore = walkNext(gr) >= lc && returned < 0 && cellQ(gr).count == 0 && pending(gr).isEmpty &&
             itemReads(gr).isEmpty && itemQ(gr).count == 0
           val win = window(gr)
-          val op = win.nonEmpty && (win.length == g || noMore) &&
+          val op = win.nonEmpty && win.length > win.head.left.min(g - 1) && // every item it compares is in
             (win.head.first || hitQ(gr).count + issuesLive(gr).length < p.hitQueueDepth)
           val fill = (win.length - (if (op) 1 else 0)) < g && itemQ(gr).nonEmpty
           val done = noMore && win.isEmpty && issuesLive(gr).isEmpty

@@ -26,9 +26,10 @@ object BinningExplore {
     }
   }
 
-  def row(p: BinningParams, boxes: Seq[BinScenes.FloatBox], edge: Double, cells: Int): Row = {
+  def row(p: BinningParams, boxes: Seq[BinScenes.FloatBox], edge: Double, cells: Int,
+          offer: Long => Boolean = _ => true): Row = {
     val f = BinScenes.quantize(p, boxes, edge, cells)
-    Row(p, cells, BinningCycleModel.run(p, f))
+    Row(p, cells, BinningCycleModel.run(p, f, offer = offer))
   }
 
   def main(args: Array[String]): Unit = {
@@ -36,6 +37,15 @@ object BinningExplore {
     val seed = args.lift(1).map(_.toInt).getOrElse(1)
     val (boxes, edge) = BinScenes.benchLike(new Random(seed), n)
     println(f"scene: $n boxes, edge $edge%.2f, largest extent ${boxes.map(b => b.hi.zip(b.lo).map { case (h, l) => h - l }.max).max}%.3f")
+    if (args.lift(2).contains("defaults")) {
+      val d = BinningParams()
+      println(s"defaults: $d")
+      for (cells <- Seq(8, 12, 14, 16)) println("host at w boxes/cycle:    " + row(d, boxes, edge, cells).line)
+      // A 256-bit stream carries 8 words a beat: 2.67 boxes of 3 words; the shell hands over 4 in 2 of 3 cycles.
+      for (cells <- Seq(12, 16)) println("host at 2.67 boxes/cycle: " + row(d, boxes, edge, cells, t => t % 3 != 0).line)
+      for (cells <- Seq(12, 16)) println("P = 4:                    " + row(d.copy(pairsPerBeat = 4), boxes, edge, cells).line)
+      return
+    }
     if (args.lift(2).contains("queues")) {
       val base = BinningParams(keyWidth = 12, cellBits = 4, boxCapacity = 8192, groupCapacity = 8192)
       for ((lq, mq) <- Seq(1 -> 1, 1 -> 2, 1 -> 4, 2 -> 2, 2 -> 4, 4 -> 8); cells <- Seq(12, 16)) {

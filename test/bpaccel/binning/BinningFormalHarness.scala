@@ -35,13 +35,7 @@ object BinProperty {
 class BinningFormalHarness(p: BinningParams, properties: Set[BinProperty] = Set(BinProperty.Errors, BinProperty.Summary))
     extends Module {
   require(p.intakeBoxes == 1, "the monitors take one box a beat")
-  val io = IO(new Bundle {
-    val frame   = Flipped(Decoupled(new FrameHeader))
-    val boxes   = Flipped(Decoupled(new BoxBeat(p)))
-    val abort   = Input(Bool())
-    val pairs   = Decoupled(new PairBeat(p))
-    val summary = Decoupled(new FrameSummary(p))
-  })
+  val io = IO(new BinningPorts(p))
   val dut = Module(new BinningCore(p))
   dut.io.frame <> io.frame
   dut.io.boxes <> io.boxes

@@ -125,6 +125,42 @@ class BinningModelSpec extends AnyFlatSpec with Matchers {
     }
   }
 
+  it should "follow the closed forms of each phase (prefix Lc, sort E + le + 1, first schedule cycle, back-to-back cells)" in {
+    val rng = new Random(45)
+    for (p <- configs) {
+      val shift = p.maxShift
+      val dims  = Seq.fill(3)(1 << p.cellBits)
+      val cell  = 1 << shift
+      // Two cells of group 0 first in its walk, (0,0,0) and (2^ax,0,0), with points that never overlap
+      // (no hit, so no credit stall), and random boxes elsewhere.
+      def points(x0: Int, k: Int) = Seq.tabulate(k)(i => bpaccel.Box(Seq(BigInt(x0 + i % cell), BigInt(i / cell), BigInt(0)),
+        Seq(BigInt(x0 + i % cell), BigInt(i / cell), BigInt(0))))
+      val (n0, n1) = (2 + rng.nextInt(9), 2 + rng.nextInt(9))
+      val f = BinFrame(points(0, n0) ++ points((1 << p.groupBits(0)) * cell, n1), shift, dims)
+      val r  = BinningCycleModel.run(p, f)
+      val ph = r.phases.get
+      val lc = p.localDims(dims).product
+      val le = p.memoryReadLatency
+      val binned = BinningModel.bin(p, f)
+      for (gr <- 0 until p.groups) withClue(s"$p group $gr: ") {
+        ph.sort(gr) shouldBe ph.prefix + lc
+        ph.compute(gr) shouldBe ph.sort(gr) + binned.groups(gr).length + le + 1
+      }
+      withClue(s"$p, cells of $n0 and $n1: ") {
+        // walker read C0, queued C0+1, reader's first read C0+2, 2*le through both memories, a cycle
+        // into the item queue and one into the window, min(n, g) items (all it compares): the first cell's bubble.
+        val ops = r.ops(0).map(_.cycle)
+        ops.head shouldBe ph.compute(0) + 3 + 2 * le + n0.min(p.g)
+        // Cells back to back, one bubble each: 1 + C(n, g) cycles a cell, no gap.
+        ops shouldBe (ops.head until ops.head + 2 + BinningModel.issueCycles(n0, p.g) + BinningModel.issueCycles(n1, p.g))
+        // The group is done three cycles after its last schedule cycle (its hits in flight), but not
+        // before its walker has read and cleared every cell of the walk (one a cycle from C0, never
+        // waiting here: the cell queue holds both cells).
+        ph.groupDone(0) shouldBe (ops.last + 3).max(ph.compute(0) + lc + 1)
+      }
+    }
+  }
+
   it should "end a frame with an error after the intake and a clear of every cell table row" in {
     val p = configs.head
     val ok = Box(Seq.fill(3)(BigInt(1)), Seq.fill(3)(BigInt(2)))

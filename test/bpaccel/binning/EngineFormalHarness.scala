@@ -65,7 +65,6 @@ class EngineFormalHarness(p: BinningParams, properties: Set[BinProperty] = Set(B
   reader.io.entryData := ShiftRegister(entryRead, p.memoryReadLatency)
   val noMore = stopped && !cells.io.deq.valid && reader.io.idle
   engine.io.items <> reader.io.items
-  engine.io.noMore   := noMore
   engine.io.hitFreed := hits.io.freed
   hits.io.hits := engine.io.hits
   hits.io.out.ready := io.ready
