@@ -79,12 +79,23 @@ class BinningPorts(p: BinningParams) extends Bundle {
   * Clamping keeps overlap exact: two boxes that both cover a cell overlap
   * iff their clamped intervals do on every axis (docs/binning.md).
   */
-class BinEntry(p: BinningParams) extends Bundle {
+class BinEntry(p: BinningParams) extends EntryKeys(p) {
+  val cell = UInt(p.localCellBits.W)
+
+  /** The fields a lane compares (the cell stays behind: the reader's tags say where cells end). */
+  def keys: EntryKeys = {
+    val k = Wire(new EntryKeys(p))
+    k.min := min; k.max := max; k.starts := starts; k.index := index
+    k
+  }
+}
+
+/** What a lane compares of an entry: its clamped offsets, "starts here" bits and box index. */
+class EntryKeys(p: BinningParams) extends Bundle {
   val min    = Vec(3, UInt(p.localBits.W))
   val max    = Vec(3, UInt(p.localBits.W))
   val starts = Vec(3, Bool())
   val index  = UInt(p.indexWidth.W)
-  val cell   = UInt(p.localCellBits.W)
 }
 
 /** A cell the walker found with two or more entries: where its entries start in the order memory. */
@@ -103,7 +114,7 @@ class ItemTags(p: BinningParams) extends Bundle {
 }
 
 class StreamItem(p: BinningParams) extends Bundle {
-  val entry = new BinEntry(p)
+  val entry = new EntryKeys(p)
   val tags  = new ItemTags(p)
 }
 

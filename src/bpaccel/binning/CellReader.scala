@@ -20,7 +20,7 @@ class CellReader(p: BinningParams) extends Module {
     val orderRead = Valid(UInt(p.entryAddrWidth.W))
     val orderData = Input(UInt(p.entryAddrWidth.W))
     val entryRead = Valid(UInt(p.entryAddrWidth.W))
-    val entryData = Input(new BinEntry(p))
+    val entryData = Input(new EntryKeys(p))
     val items     = Decoupled(new StreamItem(p))
     val idle      = Output(Bool()) // no cell under way, no read in flight, nothing queued
   })

@@ -5,7 +5,7 @@ import java.nio.file.{Files, Path, Paths}
 import chisel3.stage.ChiselGeneratorAnnotation
 import circt.stage.{ChiselStage, FirtoolOption}
 
-import bpaccel.{EmitVerilog, MemoryStyle, NoCollisionMemories, SingleClockMemories}
+import bpaccel.{DistributedMemories, EmitVerilog, MemoryStyle, NoCollisionMemories, SingleClockMemories}
 
 /** Emits one binning configuration: SystemVerilog (one file per module and
   * filelist.f), its C header and its JSON parameter file.
@@ -24,6 +24,12 @@ object EmitBinning {
     )
     SingleClockMemories.rewrite(targetDir)
     NoCollisionMemories.rewrite(targetDir)
+    // The table's module must not be an entry or order memory's too (same rows and width), or those would go to LUT RAM.
+    val table = CellTable.memoryModule(p)
+    if (Seq(p.entryBits, p.entryAddrWidth).map(w => s"mem_${p.groupCapacity}x$w").contains(table))
+      throw new IllegalArgumentException(s"EmitBinning: the cell table's memory module $table is also a group memory's; " +
+        "change groupCapacity or cellBits")
+    DistributedMemories.rewrite(targetDir, Seq(table))
     Files.writeString(targetDir.resolve(headerFile), BinningHeader.cHeader(p))
     Files.writeString(targetDir.resolve(jsonFile), BinningHeader.json(p))
     Files.writeString(targetDir.resolve(EmitVerilog.lintWaivers), lintWaiverText)

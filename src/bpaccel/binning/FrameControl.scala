@@ -70,7 +70,11 @@ class FrameControl(p: BinningParams) extends Module {
   io.n     := n
   io.shift := shift
   io.dims  := dims
-  io.localDims := VecInit((0 until 3).map(a => ((dims(a) +& ((1 << p.groupBits(a)) - 1).U) >> p.groupBits(a)).pad(p.cellBits + 1)))
+  // ceil(D / 2^a) as D >> a plus one when the dropped bits are not zero (no adder bit computed unused).
+  io.localDims := VecInit((0 until 3).map { a =>
+    val ga = p.groupBits(a)
+    ((dims(a) >> ga) +& dims(a)(ga - 1, 0).orR).pad(p.cellBits + 1)
+  })
 
   // ---- error: the first of the frame ----
   val error  = RegInit(BinningError.None)

@@ -39,8 +39,8 @@ class GroupEngine(p: BinningParams) extends Module {
   })
   val window = Reg(Vec(g, new StreamItem(p)))
   val filled = RegInit(VecInit(Seq.fill(g)(false.B))) // lanes 0 .. v-1 hold items
-  val a      = Reg(Vec(g, new BinEntry(p)))
-  val aNext  = Reg(Vec(g, new BinEntry(p)))
+  val a      = Reg(Vec(g, new EntryKeys(p)))
+  val aNext  = Reg(Vec(g, new EntryKeys(p)))
   val credits = RegInit(p.hitQueueDepth.U(log2Ceil(p.hitQueueDepth + 1).W))
 
   val lane0   = window(0)
@@ -80,10 +80,10 @@ class GroupEngine(p: BinningParams) extends Module {
     val pairs  = Vec(g, new BinPair(p))
   }
   val strict = p.has(BinningFault.StrictCompare)
-  def overlaps(x: BinEntry, y: BinEntry): Bool = (0 until 3).map { ax =>
+  def overlaps(x: EntryKeys, y: EntryKeys): Bool = (0 until 3).map { ax =>
     if (strict) x.min(ax) < y.max(ax) && y.min(ax) < x.max(ax) else x.min(ax) <= y.max(ax) && y.min(ax) <= x.max(ax)
   }.reduce(_ && _)
-  def once(x: BinEntry, y: BinEntry): Bool =
+  def once(x: EntryKeys, y: EntryKeys): Bool =
     if (p.has(BinningFault.NoExactlyOnceRule)) true.B else (0 until 3).map(ax => x.starts(ax) || y.starts(ax)).reduce(_ && _)
   val comparedValid = RegNext(issue, false.B)
   val compared = Reg(new Compared)

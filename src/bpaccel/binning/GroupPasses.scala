@@ -62,9 +62,10 @@ class TableIncrement(p: BinningParams) extends Module {
 
 /** Reads a group's table over the frame's local cells, one row a cycle in
   * walk order while `advance` holds, from the cycle after `start`; each row
-  * comes back a cycle after its read (`returned`).
+  * comes back a cycle after its read (`returned`). It has the end signals its
+  * caller asks for: `last` (the prefix pass) or `running` (the walker).
   */
-class TableWalk(p: BinningParams) extends Module {
+class TableWalk(p: BinningParams, withLast: Boolean = false, withRunning: Boolean = false) extends Module {
   val io = IO(new Bundle {
     val start     = Input(Bool())
     val localDims = Input(Vec(3, UInt((p.cellBits + 1).W)))
@@ -72,8 +73,8 @@ class TableWalk(p: BinningParams) extends Module {
     val read      = Valid(UInt(p.localCellBits.W))
     val readData  = Input(UInt(p.entryCountWidth.W))
     val returned  = Valid(new Bundle { val row = UInt(p.localCellBits.W); val data = UInt(p.entryCountWidth.W) })
-    val last      = Output(Bool()) // this cycle reads the last row
-    val running   = Output(Bool()) // rows are left to read
+    val last      = Option.when(withLast)(Output(Bool()))    // this cycle reads the last row
+    val running   = Option.when(withRunning)(Output(Bool())) // rows are left to read
   })
   val scan    = Module(new CellScan(p))
   val running = RegInit(false.B)
@@ -86,9 +87,10 @@ class TableWalk(p: BinningParams) extends Module {
   io.returned.valid     := RegNext(reads, false.B)
   io.returned.bits.row  := RegNext(scan.io.cell)
   io.returned.bits.data := io.readData
-  io.last    := reads && scan.io.last
-  io.running := running
-  when(io.last) { running := false.B }
+  val last    = reads && scan.io.last
+  io.last.foreach(_ := last)
+  io.running.foreach(_ := running)
+  when(last) { running := false.B }
   when(io.start) { running := true.B }
 }
 
@@ -104,7 +106,7 @@ class PrefixPass(p: BinningParams) extends Module {
     val table     = new TablePorts(p)
     val next      = Output(Bool())
   })
-  val walk = Module(new TableWalk(p))
+  val walk = Module(new TableWalk(p, withLast = true))
   val sum  = Reg(UInt(p.entryCountWidth.W))
   walk.io.start     := io.start
   walk.io.localDims := io.localDims
@@ -116,7 +118,7 @@ class PrefixPass(p: BinningParams) extends Module {
   io.table.write.bits.data  := sum
   when(walk.io.returned.valid) { sum := sum + walk.io.returned.bits.data }
   when(io.start) { sum := 0.U }
-  io.next := walk.io.last
+  io.next := walk.io.last.get
 }
 
 /** The sort pass: reads the group's E entries in memory order, one a cycle
@@ -150,6 +152,8 @@ class SortPass(p: BinningParams) extends Module {
   val incremented = RegNext(address) // the address whose cursor comes back now
   val mine        = RegNext(arriving, false.B) // the table increment's result is this pass's
   assert(!mine || io.cursor.valid, "the sort's cursor did not come back")
+  // A cursor lies below the group's entry count, so its order-memory row fits entryAddrWidth bits.
+  assert(!mine || io.cursor.bits.old < io.entries, "a sort cursor ran past the group's entries")
   io.orderWrite.valid     := mine
   io.orderWrite.bits.row  := io.cursor.bits.old
   io.orderWrite.bits.data := incremented
@@ -173,7 +177,7 @@ class CellWalker(p: BinningParams) extends Module {
     val done      = Output(Bool()) // every cell read and its row cleared
   })
   val queue = Module(new Queue(new CellRun(p), p.cellQueueDepth))
-  val walk  = Module(new TableWalk(p))
+  val walk  = Module(new TableWalk(p, withRunning = true))
   val back  = walk.io.returned
   walk.io.start     := io.start
   walk.io.localDims := io.localDims
@@ -192,5 +196,5 @@ class CellWalker(p: BinningParams) extends Module {
   when(back.valid) { prevEnd := back.bits.data }
   when(io.start) { prevEnd := 0.U }
   io.cells <> queue.io.deq
-  io.done := !walk.io.running && !back.valid
+  io.done := !walk.io.running.get && !back.valid
 }

@@ -34,10 +34,11 @@ object BoxCells {
     d.index := index
     val lo = box.bits.min.map(_ >> shift)
     val hi = box.bits.max.map(_ >> shift)
-    val lowMask  = ((1.U((p.keyWidth + 1).W) << shift) - 1.U)(p.localBits - 1, 0)
+    // The offset bits of a key, (1 << shift) - 1 over localBits bits: bit i is set when i < shift.
+    val lowMask  = VecInit((0 until p.localBits).map(i => shift > i.U)).asUInt
     val inverted = (0 until 3).map(a => box.bits.min(a) > box.bits.max(a)).reduce(_ || _)
     val outside  = (0 until 3).map(a => if (p.has(BinningFault.OutOfGridOffByOne)) hi(a) > dims(a) else hi(a) >= dims(a)).reduce(_ || _)
-    val wide     = (0 until 3).map(a => hi(a) - lo(a) > 1.U).reduce(_ || _)
+    val wide     = (0 until 3).map(a => hi(a) > lo(a) +& 1.U).reduce(_ || _)
     d.error := MuxCase(BinningError.None, Seq(
       (index >= n) -> BinningError.LengthMismatch,
       inverted     -> BinningError.BoxInverted,

@@ -54,7 +54,9 @@ class LaneGroup(p: BinningParams) extends Module {
     c.valid := io.clear.valid; c.bits.row := io.clear.bits; c.bits.data := 0.U
     c
   }
-  assert(PopCount(readers.map(_.valid)) <= 1.U && PopCount(writers.map(_.valid)) <= 1.U, "two phases used the cell table at once")
+  // At most one valid: clearing the lowest set bit leaves none (every bit of v - 1 is used, unlike PopCount <= 1's sum).
+  def atMostOne(valids: Seq[Bool]): Bool = { val v = VecInit(valids).asUInt; (v & (v - 1.U)) === 0.U }
+  assert(atMostOne(readers.map(_.valid)) && atMostOne(writers.map(_.valid)), "two phases used the cell table at once")
   table.io.read.valid := readers.map(_.valid).reduce(_ || _)
   table.io.read.bits  := PriorityMux(readers.map(_.valid) :+ true.B, readers.map(_.bits) :+ 0.U)
   table.io.write.valid := writers.map(_.valid).reduce(_ || _)
@@ -83,7 +85,7 @@ class LaneGroup(p: BinningParams) extends Module {
   reader.io.orderData := orderMemory.io.readData
   entryMemory.io.read.valid := sort.io.entryRead.valid || reader.io.entryRead.valid
   entryMemory.io.read.bits  := Mux(sort.io.entryRead.valid, sort.io.entryRead.bits, reader.io.entryRead.bits)
-  reader.io.entryData := entryMemory.io.readData.asTypeOf(new BinEntry(p))
+  reader.io.entryData := entryMemory.io.readData.asTypeOf(new BinEntry(p)).keys
   val noMore = walker.io.done && !walker.io.cells.valid && reader.io.idle
   engine.io.items <> reader.io.items
   engine.io.hitFreed := hits.io.freed
@@ -110,6 +112,9 @@ class LaneGroup(p: BinningParams) extends Module {
   * then a cell's end), one read and one write port, the read a cycle late.
   * A read that meets a write of its row is never used (TableIncrement
   * forwards the write instead), so the memory needs no collision bypass.
+  * It is small (localCells x entryCountWidth, 128 x 11 by default), so the
+  * emitted module asks for LUT RAM (bpaccel.DistributedMemories) and leaves
+  * the block RAM to the entry and order memories.
   */
 class CellTable(p: BinningParams) extends Module {
   val io = IO(new Bundle {
@@ -120,6 +125,11 @@ class CellTable(p: BinningParams) extends Module {
   val mem = SyncReadMem(p.localCells, UInt(p.entryCountWidth.W))
   when(io.write.valid) { mem.write(io.write.bits.row, io.write.bits.data) }
   io.readData := mem.read(io.read.bits, io.read.valid)
+}
+
+object CellTable {
+  /** The memory module firtool emits for the table. */
+  def memoryModule(p: BinningParams): String = s"mem_${p.localCells}x${p.entryCountWidth}"
 }
 
 object GroupCounters {

@@ -8,7 +8,7 @@ import scala.sys.process._
 import org.scalatest.flatspec.AnyFlatSpec
 import org.scalatest.matchers.should.Matchers
 
-import bpaccel.{EmitVerilog, NoCollisionMemories, SingleClockMemories}
+import bpaccel.{DistributedMemories, EmitVerilog, NoCollisionMemories, SingleClockMemories}
 
 /** What FPGA flows and hosts get from EmitBinning: lint-clean SystemVerilog,
   * memories that synthesis maps to block RAM, and a C header and JSON file
@@ -46,6 +46,8 @@ class BinningEmissionSpec extends AnyFlatSpec with Matchers {
     for (m <- memories) withClue(s"$m: ") {
       read(dir, m) should include(NoCollisionMemories.attribute)
       read(dir, m) should not include "R0_clk"
+      // Only the cell table asks for LUT RAM.
+      (read(dir, m).contains(DistributedMemories.attribute)) shouldBe (m == s"${CellTable.memoryModule(p)}.sv")
     }
     // Each group instantiates the three; there are G groups.
     "(?m)^\\s*LaneGroup\\s+\\w+\\s*\\(".r.findAllIn(read(dir, "BinningCore.sv")).length shouldBe p.groups
@@ -53,18 +55,23 @@ class BinningEmissionSpec extends AnyFlatSpec with Matchers {
 
   it should "map the entry and order memories alone to ECP5 block RAM (DP16KD) and the cell table to LUT RAM" in {
     val (p, dir) = default
-    def cells(module: String): Map[String, Int] = {
-      val (exit, log) = run(dir, Seq("yosys", "-q", "-p", s"read_verilog -sv $module.sv; synth_ecp5 -top $module; tee -o $module.stat stat"))
+    def cells(module: String, file: String): Map[String, Int] = {
+      val (exit, log) = run(dir, Seq("yosys", "-q", "-p", s"read_verilog -sv $file; synth_ecp5 -top $module; tee -o $file.stat stat"))
       withClue(log.takeRight(3000)) { exit shouldBe 0 }
-      "(?m)^\\s+(\\w+)\\s+(\\d+)$".r.findAllMatchIn(read(dir, s"$module.stat")).map(x => x.group(1) -> x.group(2).toInt).toMap
+      "(?m)^\\s+(\\w+)\\s+(\\d+)$".r.findAllMatchIn(read(dir, s"$file.stat")).map(x => x.group(1) -> x.group(2).toInt).toMap
     }
-    val entries = cells(s"mem_${p.groupCapacity}x${p.entryBits}")
+    def memory(module: String): Map[String, Int] = cells(module, s"$module.sv")
+    val entries = memory(s"mem_${p.groupCapacity}x${p.entryBits}")
     entries.getOrElse("DP16KD", 0) shouldBe 4 // 1024 x 71: four 1024 x 18 blocks
     entries.keys.filter(_.startsWith("TRELLIS_DPR")) shouldBe empty
-    cells(s"mem_${p.groupCapacity}x${p.entryAddrWidth}").getOrElse("DP16KD", 0) shouldBe 1
-    val table = cells(s"mem_${p.localCells}x${p.entryCountWidth}")
+    memory(s"mem_${p.groupCapacity}x${p.entryAddrWidth}").getOrElse("DP16KD", 0) shouldBe 1
+    val tableModule = CellTable.memoryModule(p)
+    val table = memory(tableModule)
     table.getOrElse("DP16KD", 0) shouldBe 0
-    table.getOrElse("TRELLIS_DPR16X4", 0) should be > 0
+    table.getOrElse("TRELLIS_DPR16X4", 0) shouldBe 24 // 128 x 11: 8 x 3 blocks of 16 x 4
+    // The attribute does it: without it, Yosys puts the table into a DP16KD of its own.
+    Files.writeString(dir.resolve("bare-table.sv"), read(dir, s"$tableModule.sv").replace(s"${DistributedMemories.attribute} ", ""))
+    cells(tableModule, "bare-table.sv").getOrElse("DP16KD", 0) shouldBe 1
   }
 
   it should "write a C header and a JSON file with the parameters and every error code" in {

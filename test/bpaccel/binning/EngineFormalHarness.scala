@@ -23,7 +23,7 @@ class EngineFormalHarness(p: BinningParams, properties: Set[BinProperty] = Set(B
   val io = IO(new Bundle {
     val cell  = Input(Bool())                          // give a cell now
     val n     = Input(UInt(p.entryCountWidth.W))       // ... of n entries
-    val entries = Input(Vec(cap, new BinEntry(p)))      // ... these at its positions
+    val entries = Input(Vec(cap, new EntryKeys(p)))     // ... these at its positions
     val stop  = Input(Bool())                          // no more cells from now on
     val ready = Input(Bool())                          // the consumer of pairs
   })
@@ -36,7 +36,7 @@ class EngineFormalHarness(p: BinningParams, properties: Set[BinProperty] = Set(B
 
   // ---- entries: each cell's come with it (from a free input; ChiselTest's formal flow starts
   // registers at 0, so they cannot be left free); an entry's index is its position ----
-  val entries = Reg(Vec(cap, new BinEntry(p)))
+  val entries = Reg(Vec(cap, new EntryKeys(p)))
 
   // ---- cells: consecutive runs, queued as the walker queues them ----
   val cells   = Module(new Queue(new CellRun(p), p.cellQueueDepth))
@@ -59,7 +59,7 @@ class EngineFormalHarness(p: BinningParams, properties: Set[BinProperty] = Set(B
   reader.io.cells <> cells.io.deq
   reader.io.orderData := ShiftRegister(reader.io.orderRead.bits, p.memoryReadLatency)
   val position = reader.io.entryRead.bits(log2Ceil(cap).max(1) - 1, 0)
-  val entryRead = Wire(new BinEntry(p))
+  val entryRead = Wire(new EntryKeys(p))
   entryRead := entries(position)
   entryRead.index := position
   reader.io.entryData := ShiftRegister(entryRead, p.memoryReadLatency)
