@@ -70,7 +70,7 @@ test-hw: deps
 # The formal checks at depths that cover a whole run of each small
 # configuration (docs/verification.md); `make test` runs shallower ones.
 formal-long: deps
-	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec"
+	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec bpaccel.binning.BinningFormalSpec"
 
 # The C++ host (build/bin/bpaccel) with the Verilated accelerator, and its tests.
 $(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
