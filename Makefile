@@ -73,7 +73,7 @@ test-hw: deps
 # The formal checks at depths that cover a whole run of each small
 # configuration (docs/verification.md); `make test` runs shallower ones.
 formal-long: deps
-	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec bpaccel.FormalMutantSpec"
+	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec bpaccel.FormalMutantSpec bpaccel.binning.BinningFormalSpec"
 
 # The C++ host (build/bin/bpaccel, build/bin/bpaccel-bench) with the Verilated accelerator, and its tests.
 EMIT_HOST = "runMain bpaccel.EmitVerilog $(EMIT_ARGS) --target-dir $(HOST_VERILOG)"
