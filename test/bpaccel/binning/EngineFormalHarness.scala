@@ -43,15 +43,15 @@ class EngineFormalHarness(p: BinningParams, properties: Set[BinProperty] = Set(B
   val next    = RegInit(0.U(p.entryCountWidth.W)) // first position of the next cell
   val stopped = RegInit(false.B)
   val cellOf  = Reg(Vec(cap, UInt(log2Ceil(cap + 1).W))) // which cell each position was given to
-  val given   = RegInit(0.U(log2Ceil(cap + 1).W))
+  val cellsGiven = RegInit(0.U(log2Ceil(cap + 1).W))
   val gives   = io.cell && !stopped && !io.stop && io.n >= 2.U && next +& io.n <= cap.U && cells.io.enq.ready
   cells.io.enq.valid      := gives
   cells.io.enq.bits.start := next
   cells.io.enq.bits.n     := io.n
   when(gives) {
     next  := next + io.n
-    given := given + 1.U
-    for (k <- 0 until cap) when(k.U >= next && k.U < next + io.n) { cellOf(k) := given; entries(k) := io.entries(k) }
+    cellsGiven := cellsGiven + 1.U
+    for (k <- 0 until cap) when(k.U >= next && k.U < next + io.n) { cellOf(k) := cellsGiven; entries(k) := io.entries(k) }
   }
   when(io.stop) { stopped := true.B }
 
