@@ -34,8 +34,14 @@ FPGA_NAME := $(ARCH_PREFIX)m$(M)$(KEY_SUFFIX)$(if $(filter $(FPGA_DEFAULT_MEMORY
 
 # The host is built for one configuration: ARCH, M, CAPACITY and KEY_WIDTH
 # above (a device with narrower keys gets each cell's keys narrowed and the
-# host checks its pairs with the full keys; docs/host.md).
-HOST_VERILOG := build/verilog/$(ARCH_PREFIX)m$(M)-c$(CAPACITY)$(KEY_SUFFIX)
+# host checks its pairs with the full keys; docs/host.md). It verilates the
+# AXI shell around that core (docs/integration.md): the shell's Verilog,
+# bpaccel_params.h and bpaccel_shell.h come from one emission. Its streams
+# carry a box a beat or more (256 bits for keys above 16 bits, 128 below),
+# so the core takes a box a cycle and its cycles are the model's.
+HOST_STREAM_BITS ?= $(shell [ $(KEY_WIDTH) -le 16 ] && echo 128 || echo 256)
+HOST_DUAL_CLOCK  ?= true
+HOST_VERILOG := build/host-shell/$(ARCH_PREFIX)m$(M)-c$(CAPACITY)$(KEY_SUFFIX)-w$(HOST_STREAM_BITS)$(if $(filter true,$(HOST_DUAL_CLOCK)),,-1clk)
 HOST_BUILD   := build/host-$(ARCH_PREFIX)m$(M)-c$(CAPACITY)$(KEY_SUFFIX)
 # Where the bpaccel CLI goes; the benchmark's configuration gets its own.
 # A device of narrower keys gets its own too (build/bin-k16).
@@ -72,9 +78,9 @@ test-hw: deps
 formal-long: deps
 	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec"
 
-# The C++ host (build/bin/bpaccel, build/bin/bpaccel-bench) with the Verilated accelerator, and its tests.
-$(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
-	$(SBT) "runMain bpaccel.EmitVerilog --arch $(ARCH) --m $(M) --capacity $(CAPACITY) --key-width $(KEY_WIDTH) --target-dir $(HOST_VERILOG)"
+# The C++ host (build/bin/bpaccel, build/bin/bpaccel-bench) with the Verilated shell and core, and its tests.
+$(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) $(wildcard src/bpaccel/shell/*.scala) | deps
+	$(SBT) "runMain bpaccel.shell.EmitShell --arch $(ARCH) --m $(M) --capacity $(CAPACITY) --key-width $(KEY_WIDTH) --stream-bits $(HOST_STREAM_BITS) --dual-clock $(HOST_DUAL_CLOCK) --target-dir $(HOST_VERILOG)"
 
 host: deps $(HOST_VERILOG)/filelist.f
 	cmake -S host -B $(HOST_BUILD) -G Ninja -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BIN_DIR=$(abspath $(HOST_BIN_DIR))
