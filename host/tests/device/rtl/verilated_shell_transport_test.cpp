@@ -119,7 +119,57 @@ std::vector<std::uint32_t> concat(std::initializer_list<std::vector<std::uint32_
 
 constexpr std::uint32_t kCells = BPACCEL_SHELL_OP_CELLS | BPACCEL_SHELL_PROTOCOL_VERSION << 8;
 
+// A transport between the driver and the Verilated shell that raises the
+// count of the first cell of the next packet above the capacity, after the
+// driver's own checks: the device, not the host, finds the error.
+class CountCorruptingTransport final : public ShellTransport {
+ public:
+  explicit CountCorruptingTransport(ShellTransport& inner) : inner_(inner) {}
+  bool corruptNext = false;
+
+  std::uint32_t readRegister(std::uint32_t offset) override { return inner_.readRegister(offset); }
+  void writeRegister(std::uint32_t offset, std::uint32_t value) override { inner_.writeRegister(offset, value); }
+  void postReceive(std::size_t maxWords) override { inner_.postReceive(maxWords); }
+  void send(std::span<const std::uint32_t> packet) override {
+    std::vector<std::uint32_t> words(packet.begin(), packet.end());
+    if (corruptNext) words.at(2) = BPACCEL_CAPACITY + 1;  // header, cell count, then cell 0's count
+    corruptNext = false;
+    inner_.send(words);
+  }
+  bool receive(std::vector<std::uint32_t>& reply, std::chrono::microseconds timeout) override {
+    return inner_.receive(reply, timeout);
+  }
+  bool waitInterrupt(std::chrono::microseconds timeout) override { return inner_.waitInterrupt(timeout); }
+  void resetChannels() override { inner_.resetChannels(); }
+  std::chrono::nanoseconds now() override { return inner_.now(); }
+
+ private:
+  ShellTransport& inner_;
+};
+
 }  // namespace
+
+TEST(VerilatedShell, ADeviceErrorThrowsNamingItsCodeAndTheNextCommandIsExact) {
+  VerilatedShellTransport verilated;
+  CountCorruptingTransport transport(verilated);
+  ShellDriver driver(transport, quickDriver());
+  const Cells cells(3, 30, 14);
+  std::vector<Pair> out = {{7, 9}};
+  std::vector<std::size_t> ends = {1};
+  transport.corruptNext = true;
+  try {
+    driver.runCells(cells.command(), out, ends);
+    ADD_FAILURE() << "a device error was not reported";
+  } catch (const ShellDeviceError& e) {
+    EXPECT_EQ(shellErrorName(e.code()), "COUNT_OVER_CAPACITY");
+    EXPECT_EQ(e.detail(), 0u);  // the cell
+    EXPECT_NE(std::string(e.what()).find("COUNT_OVER_CAPACITY"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(out, (std::vector<Pair>{{7, 9}}));  // nothing of the failed command kept
+  EXPECT_EQ(ends, (std::vector<std::size_t>{1}));
+  EXPECT_EQ(driver.events().recoveries, 0u);  // the error reply kept the streams in step
+  expectSameAnswer(shellAnswer(driver, cells), modelAnswer(cells), "after the device error");
+}
 
 TEST(VerilatedShell, DeviceErrorsComeBackAsTrailersNamingTheCellAndTheStreamStaysInStep) {
   Shell shell;
