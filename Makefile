@@ -4,33 +4,32 @@
 SHELL := /bin/bash
 SBT   := ./scripts/sbt
 
+# Debian's interpreter, which has python3-matplotlib.
+PYTHON := /usr/bin/python3
+
 # Configuration of `make verilog` (see README): architecture (stream: one
 # memory read a cycle, the default: faster and half the LUTs of the seed at
 # m = 8 (docs/fpga.md), and it scales; seed: the published design, see
-# docs/microarchitecture.md), parallelism, objects per run, key width.
+# docs/microarchitecture.md), parallelism, objects per run (empty: the
+# architecture's default, which the generator knows), key width. The
+# generator's defaults are these (AccelParamsSpec checks it).
 ARCH      ?= stream
 M         ?= 8
-ifeq ($(ARCH),stream)
-CAPACITY  ?= 2048
-else
-CAPACITY  ?= $(shell echo $$((256 * $(M))))
-endif
+CAPACITY  ?=
 KEY_WIDTH ?= 32
 # How `make verilog` builds the coordinate memories (docs/fpga.md): inferred
-# (SyncReadMem) or ecp5-outreg (the first output register inside the DP16KD;
-# same cycles). `make fpga` uses FPGA_MEMORY_STYLE, by default inferred: at
-# m = 8 ecp5-outreg was not measured faster (stream: +4 and -4 MHz at two
-# revisions; seed: 73.9 against 106.1 MHz, with two DP16KD per memory);
-# reports of a style other than the flow's default get it as suffix.
-MEMORY_STYLE ?= inferred
-FPGA_DEFAULT_MEMORY_STYLE := inferred
-FPGA_MEMORY_STYLE ?= $(FPGA_DEFAULT_MEMORY_STYLE)
-# Folders and reports of the seed architecture keep their names; others get the architecture as prefix.
-ARCH_PREFIX := $(if $(filter seed,$(ARCH)),,$(ARCH)-)
-VERILOG_DIR ?= generated/$(ARCH_PREFIX)m$(M)
-# Folders and reports of a key width other than 32 get it as suffix (-k16).
-KEY_SUFFIX := $(if $(filter 32,$(KEY_WIDTH)),,-k$(KEY_WIDTH))
-FPGA_NAME := $(ARCH_PREFIX)m$(M)$(KEY_SUFFIX)$(if $(filter $(FPGA_DEFAULT_MEMORY_STYLE),$(FPGA_MEMORY_STYLE)),,-$(FPGA_MEMORY_STYLE))
+# (SyncReadMem, the default) or ecp5-outreg (the first output register inside
+# the DP16KD; same cycles). `make fpga` builds FPGA_MEMORY_STYLE, by default
+# inferred too: ecp5-outreg was not measured faster at m = 8 (docs/fpga.md).
+MEMORY_STYLE ?=
+FPGA_MEMORY_STYLE ?=
+EMIT_ARGS = --arch $(ARCH) --m $(M) --key-width $(KEY_WIDTH) $(if $(CAPACITY),--capacity $(CAPACITY))
+# Folder and report names come from one rule (scripts/fpga/fpgaflow/names.py).
+NAMES = $(PYTHON) scripts/fpga/names.py --arch $(ARCH) --m $(M) --key-width $(KEY_WIDTH) $(if $(CAPACITY),--capacity $(CAPACITY))
+DESIGN_NAME := $(shell $(NAMES))
+KEY_SUFFIX  := $(shell $(NAMES) --key-suffix)
+FPGA_NAME   := $(shell $(NAMES) $(if $(FPGA_MEMORY_STYLE),--memory-style $(FPGA_MEMORY_STYLE)))
+VERILOG_DIR ?= generated/$(shell $(NAMES) $(if $(MEMORY_STYLE),--memory-style $(MEMORY_STYLE)))
 
 # The host is built for one configuration: ARCH, M, CAPACITY and KEY_WIDTH
 # above (a device with narrower keys gets each cell's keys narrowed and the
@@ -41,16 +40,15 @@ FPGA_NAME := $(ARCH_PREFIX)m$(M)$(KEY_SUFFIX)$(if $(filter $(FPGA_DEFAULT_MEMORY
 # so the core takes a box a cycle and its cycles are the model's.
 HOST_STREAM_BITS ?= $(shell [ $(KEY_WIDTH) -le 16 ] && echo 128 || echo 256)
 HOST_DUAL_CLOCK  ?= true
-HOST_VERILOG := build/host-shell/$(ARCH_PREFIX)m$(M)-c$(CAPACITY)$(KEY_SUFFIX)-w$(HOST_STREAM_BITS)$(if $(filter true,$(HOST_DUAL_CLOCK)),,-1clk)
-HOST_BUILD   := build/host-$(ARCH_PREFIX)m$(M)-c$(CAPACITY)$(KEY_SUFFIX)
+HOST_VERILOG := build/host-shell/$(DESIGN_NAME)-w$(HOST_STREAM_BITS)$(if $(filter true,$(HOST_DUAL_CLOCK)),,-1clk)
+HOST_BUILD   := build/host-$(DESIGN_NAME)
 # Where the bpaccel CLI goes; the benchmark's configuration gets its own.
 # A device of narrower keys gets its own too (build/bin-k16).
 HOST_BIN_DIR ?= build/bin$(KEY_SUFFIX)
 SCALA_SOURCES := $(wildcard src/bpaccel/*.scala) build.sbt
-
-# Debian's interpreter, which has python3-matplotlib.
-PYTHON := /usr/bin/python3
-# Extra options for `bpaccel-bench run` (see `build/bench-bin/bpaccel-bench run --help`).
+# Non-empty when one of the files $(1) is missing or older than a Scala source.
+stale = $(strip $(foreach f,$(1),$(if $(wildcard $(f)),$(shell find $(SCALA_SOURCES) -newer $(f) | head -1),missing)))
+# Extra options for `bpaccel-bench run` (see `build/bin/bpaccel-bench run --help`).
 BENCH_ARGS ?=
 
 # The FPGA flow's own test runs on this configuration.
@@ -65,22 +63,28 @@ all: test
 deps:
 	@./scripts/deps.sh
 
-# Every test of the project.
-test: deps test-hw test-host test-fpga test-fuzz
+# Every test of the project, part by part; the last line gives each part's
+# time against the 10-minute budget (scripts/test_parts.sh).
+test: deps
+	@MAKE="$(MAKE)" scripts/test_parts.sh sbt=test-hw host=test-host fpga=test-fpga fuzz=test-fuzz
 
 # The Chisel generator: golden model, ChiselTest (Scala simulator and Verilator),
-# Verilog lint and memory structure.
+# Verilog lint and memory structure. The same sbt session then emits the
+# Verilog the host and the FPGA flow's test build, where it is out of date,
+# which spares each an sbt start-up.
 test-hw: deps
-	$(SBT) test
+	$(SBT) test $(if $(call stale,$(HOST_VERILOG)/filelist.f),$(EMIT_HOST)) \
+	  $(if $(call stale,$(FPGA_TEST_VERILOG)/filelist.f $(FPGA_TEST_STREAM_VERILOG)/filelist.f),$(EMIT_FPGA_TEST))
 
 # The formal checks at depths that cover a whole run of each small
 # configuration (docs/verification.md); `make test` runs shallower ones.
 formal-long: deps
-	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec"
+	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec bpaccel.FormalMutantSpec"
 
 # The C++ host (build/bin/bpaccel, build/bin/bpaccel-bench) with the Verilated shell and core, and its tests.
+EMIT_HOST = "runMain bpaccel.shell.EmitShell $(EMIT_ARGS) --stream-bits $(HOST_STREAM_BITS) --dual-clock $(HOST_DUAL_CLOCK) --target-dir $(HOST_VERILOG)"
 $(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) $(wildcard src/bpaccel/shell/*.scala) | deps
-	$(SBT) "runMain bpaccel.shell.EmitShell --arch $(ARCH) --m $(M) --capacity $(CAPACITY) --key-width $(KEY_WIDTH) --stream-bits $(HOST_STREAM_BITS) --dual-clock $(HOST_DUAL_CLOCK) --target-dir $(HOST_VERILOG)"
+	$(SBT) $(EMIT_HOST)
 
 host: deps $(HOST_VERILOG)/filelist.f
 	cmake -S host -B $(HOST_BUILD) -G Ninja -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BIN_DIR=$(abspath $(HOST_BIN_DIR))
@@ -124,7 +128,7 @@ bench-large-run: host
 
 # The same host, Verilated model and tests under AddressSanitizer and
 # UndefinedBehaviorSanitizer (host/cmake/sanitize.cmake); any report fails.
-HOST_SANITIZE_BUILD := build/host-asan-$(ARCH_PREFIX)m$(M)-c$(CAPACITY)$(KEY_SUFFIX)
+HOST_SANITIZE_BUILD := build/host-asan-$(DESIGN_NAME)
 SANITIZER_ENV := ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1:strict_init_order=1 \
                  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 host-sanitize: deps $(HOST_VERILOG)/filelist.f
@@ -146,7 +150,10 @@ print-other-arch:
 # libFuzzer targets on the box-file parser and the pair-finding API
 # (host/fuzz/README.md), built with clang, ASan and UBSan; no Verilator needed.
 FUZZ_BUILD   := build/fuzz
-FUZZ_SECONDS ?= 60
+# make test replays each target's committed corpus and searches on for
+# FUZZ_SECONDS (20 s: about 120,000 box-file and 24,000 pairs inputs);
+# fuzz-long is the deep search.
+FUZZ_SECONDS ?= 20
 FUZZ_RUNS    ?= 1000000
 fuzz: deps
 	cmake -S host/fuzz -B $(FUZZ_BUILD) -G Ninja -DCMAKE_CXX_COMPILER=clang++
@@ -164,27 +171,29 @@ fuzz-long: fuzz
 # Fmax, and a Xilinx 7-series synthesis estimate.
 fpga: deps
 	$(MAKE) verilog ARCH=$(ARCH) M=$(M) CAPACITY=$(CAPACITY) KEY_WIDTH=$(KEY_WIDTH) MEMORY_STYLE=$(FPGA_MEMORY_STYLE) VERILOG_DIR=build/fpga-verilog/$(FPGA_NAME)
-	$(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/$(FPGA_NAME) --m $(M) --out results/fpga/$(FPGA_NAME).json $(FPGA_ARGS)
+	$(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/$(FPGA_NAME) --out results/fpga/$(FPGA_NAME).json $(FPGA_ARGS)
 
 fpga-sweep: deps
-	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --key-width $(KEY_WIDTH) --memory-style $(FPGA_MEMORY_STYLE) --verilog-root build/fpga-verilog --emit always --budget-min 60
+	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --key-width $(KEY_WIDTH) $(if $(CAPACITY),--capacity $(CAPACITY)) $(if $(FPGA_MEMORY_STYLE),--memory-style $(FPGA_MEMORY_STYLE)) --verilog-root build/fpga-verilog --emit always --budget-min 60
 
-$(FPGA_TEST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
-	$(SBT) "runMain bpaccel.EmitVerilog --arch seed --m 2 --target-dir $(FPGA_TEST_VERILOG)"
-$(FPGA_TEST_STREAM_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
-	$(SBT) "runMain bpaccel.EmitVerilog --arch stream --m 2 --target-dir $(FPGA_TEST_STREAM_VERILOG)"
+# Both architectures at m = 2 (the stream with a small memory, so the flow stays quick), emitted by one sbt run.
+EMIT_FPGA_TEST = "runMain bpaccel.EmitVerilog --arch seed --m 2 --target-dir $(FPGA_TEST_VERILOG)" \
+                 "runMain bpaccel.EmitVerilog --arch stream --m 2 --capacity 512 --target-dir $(FPGA_TEST_STREAM_VERILOG)"
+$(FPGA_TEST_VERILOG)/filelist.f $(FPGA_TEST_STREAM_VERILOG)/filelist.f &: $(SCALA_SOURCES) | deps
+	$(SBT) $(EMIT_FPGA_TEST)
 # Options for flow.py, e.g. FPGA_ARGS="--router router2 --threads 2".
 FPGA_ARGS ?=
 
-# Both architectures at m = 2, end to end.
+# The flow end to end on both architectures at m = 2.
 test-fpga: deps $(FPGA_TEST_VERILOG)/filelist.f $(FPGA_TEST_STREAM_VERILOG)/filelist.f
 	$(PYTHON) scripts/fpga/test_flow.py $(FPGA_TEST_VERILOG) $(FPGA_TEST_STREAM_VERILOG)
 
-# SystemVerilog (one file per module, filelist.f) and bpaccel_params.h for one configuration.
+# SystemVerilog (one file per module, filelist.f), bpaccel_params.h and
+# bpaccel_params.json for one configuration.
 verilog: deps
-	$(SBT) "runMain bpaccel.EmitVerilog --arch $(ARCH) --m $(M) --capacity $(CAPACITY) --key-width $(KEY_WIDTH) --memory-style $(MEMORY_STYLE) --target-dir $(VERILOG_DIR)"
+	$(SBT) "runMain bpaccel.EmitVerilog $(EMIT_ARGS) $(if $(MEMORY_STYLE),--memory-style $(MEMORY_STYLE)) --target-dir $(VERILOG_DIR)"
 	cd $(VERILOG_DIR) && verilator --lint-only -Wall lint_waivers.vlt -F filelist.f --top-module BroadPhaseAccel
-	@echo "Verilog for arch=$(ARCH), m=$(M), capacity=$(CAPACITY): $(VERILOG_DIR)/filelist.f"
+	@echo "Verilog for arch=$(ARCH), m=$(M), capacity $(if $(CAPACITY),$(CAPACITY),by default): $(VERILOG_DIR)/filelist.f"
 
 clean:
 	rm -rf target project/target generated build test_run_dir

@@ -4,8 +4,6 @@ acceleration over the fastest baseline (Bullet or a peer) of each run against
 object count, one line per cell size; every method's frame time; and the
 parts of the accelerator's frame time stacked. Skipped methods (with their
 reason in the JSON) leave gaps."""
-import argparse
-import json
 import pathlib
 import sys
 
@@ -13,6 +11,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+
+from json_input import parse_and_read  # noqa: E402
 
 
 def ran(m):
@@ -147,17 +147,8 @@ def plot_timeline(rows, out, objects=8000):
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--json", default="results/bench.json")
-    ap.add_argument("--out-dir", default="results")
-    args = ap.parse_args()
-    try:
-        data = json.loads(pathlib.Path(args.json).read_text())
-        rows = data["rows"]
-        cfg = data["configuration"]
-    except (OSError, ValueError, KeyError) as e:
-        print(f"plot_bench: cannot read {args.json}: {e}", file=sys.stderr)
-        return 1
+    args, (rows, cfg) = parse_and_read("plot_bench", __doc__, "results/bench.json", "--out-dir", "results",
+                                       ("rows", "configuration"))
     out = pathlib.Path(args.out_dir)
     out.mkdir(parents=True, exist_ok=True)
     plot_acceleration(rows, cfg, out)

@@ -1,7 +1,5 @@
 #!/usr/bin/env python3
 """Draws one frame of the bouncing-cube scene (the JSON of `bpaccel-bench scene`) as a PNG."""
-import argparse
-import json
 import pathlib
 import sys
 
@@ -11,6 +9,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
+
+from json_input import parse_and_read  # noqa: E402
 
 COLOURS = {"sphere": "tab:blue", "box": "tab:orange", "cylinder": "tab:green", "capsule": "tab:red"}
 
@@ -56,17 +56,8 @@ def draw(ax, obj):
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--json", default="results/scene.json")
-    ap.add_argument("--out", default="results/scene.png")
-    args = ap.parse_args()
-    try:
-        scene = json.loads(pathlib.Path(args.json).read_text())
-        edge = scene["cube_edge"]
-        objects = scene["objects"]
-    except (OSError, ValueError, KeyError) as e:
-        print(f"render_scene: cannot read {args.json}: {e}", file=sys.stderr)
-        return 1
+    args, (edge, objects, frame) = parse_and_read("render_scene", __doc__, "results/scene.json", "--out",
+                                                  "results/scene.png", ("cube_edge", "objects", "frame"))
     fig = plt.figure(figsize=(7, 7))
     ax = fig.add_subplot(projection="3d")
     for obj in objects:
@@ -80,7 +71,7 @@ def main() -> int:
     ax.set_ylim(0, edge)
     ax.set_zlim(0, edge)
     ax.set_box_aspect((1, 1, 1))
-    ax.set_title(f"{len(objects)} objects bouncing in a cube of edge {edge:.1f}, frame {scene['frame']}\n"
+    ax.set_title(f"{len(objects)} objects bouncing in a cube of edge {edge:.1f}, frame {frame}\n"
                  "spheres blue, boxes orange, cylinders green, capsules red", fontsize=9)
     pathlib.Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.out, dpi=110)

@@ -173,6 +173,11 @@ nlohmann::json Benchmark::run() {
   out["rows"] = nlohmann::json::array();
   for (std::size_t n : config_.objectCounts) out["rows"].push_back(runRow(n));
   if (config_.wholeStepObjects) out["whole_step"] = wholeSteps();
+  if (!config_.queries.objectCounts.empty()) {
+    QueryBenchConfig queries = config_.queries;
+    queries.scene = config_.scene;
+    out["queries"] = runQueryBench(queries, progress_);
+  }
   out["validation"] = "every frame of every method compared with the exact set: accelerator and cpu equal to it (a "
                       "difference stops the run); Bullet and peers counted (extra allowed, missing reported)";
   return out;
@@ -684,6 +689,7 @@ std::string Benchmark::table(const nlohmann::json& results) {
       t += fmt::format("  {} {:>12.3f}   {:.2f}x\n", pad(m["name"], 44), m["step_ms"]["median"].get<double>(),
                        first / m["step_ms"]["median"].get<double>());
   }
+  if (results.contains("queries")) t += queryTable(results["queries"]);
   return t;
 }
 

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "methods/accelerator_method.hpp"
+#include "query_bench.hpp"
 #include "scene.hpp"
 #include "methods/timed_method.hpp"
 #include "core/types.hpp"
@@ -31,6 +32,10 @@ struct BenchConfig {
   /// this object count; 0: none.
   std::size_t wholeStepObjects = 0;
   std::size_t wholeStepFrames = 20;
+  /// Broad-phase ray tests cast after each timed whole step (0: none).
+  std::size_t wholeStepRays = 0;
+  /// Ray and box queries (query_bench.hpp) at these object counts; empty: none.
+  QueryBenchConfig queries;
 };
 
 /// What the standard line-up holds.

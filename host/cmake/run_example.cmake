@@ -1,6 +1,8 @@
 # ctest driver: install the host library into a staging prefix, then build
 # and run host/examples/bullet_world against it twice: through
-# find_package(bpaccel CONFIG) and through pkg-config.
+# find_package(bpaccel CONFIG) and through pkg-config; where the FCL manager
+# was installed, host/examples/fcl_scene through find_package(bpaccel
+# COMPONENTS fcl) too.
 function(run)
   execute_process(COMMAND ${ARGV} RESULT_VARIABLE rc)
   if(NOT rc EQUAL 0)
@@ -16,6 +18,16 @@ run(${CMAKE_COMMAND} -S ${EXAMPLE_SOURCE} -B ${example_build} -G ${GENERATOR} -D
     -DCMAKE_PREFIX_PATH=${STAGE} -DCMAKE_BUILD_TYPE=Release)
 run(${CMAKE_COMMAND} --build ${example_build})
 run(${example_build}/bullet_world)
+
+file(GLOB fcl_targets ${STAGE}/lib*/cmake/bpaccel/bpaccelFclTargets.cmake ${STAGE}/lib/*/cmake/bpaccel/bpaccelFclTargets.cmake)
+if(fcl_targets)
+  set(fcl_build ${BUILD_DIR}/example-fcl-build)
+  file(REMOVE_RECURSE ${fcl_build})
+  run(${CMAKE_COMMAND} -S ${FCL_EXAMPLE_SOURCE} -B ${fcl_build} -G ${GENERATOR} -DCMAKE_CXX_COMPILER=${CXX}
+      -DCMAKE_PREFIX_PATH=${STAGE} -DCMAKE_BUILD_TYPE=Release)
+  run(${CMAKE_COMMAND} --build ${fcl_build})
+  run(${fcl_build}/fcl_scene)
+endif()
 
 # The same program from the pkg-config file alone.
 file(GLOB pc_file ${STAGE}/lib*/pkgconfig/bpaccel.pc ${STAGE}/lib/*/pkgconfig/bpaccel.pc)

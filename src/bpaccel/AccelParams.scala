@@ -2,26 +2,6 @@ package bpaccel
 
 import chisel3.util.log2Ceil
 
-/** The two architectures the generator builds; both have the same ports,
-  * result beats and schedule (which pairs meet in which lane, in which order).
-  *
-  *  - [[Arch.Seed]]: the published design: 6m striped dual-port memories, an
-  *    A/B address sequencer and a rotator.
-  *  - [[Arch.Stream]]: one memory read per cycle feeds an m-deep shift register
-  *    (the B window); A blocks sit in registers, the next one captured from
-  *    the window as it passes. No rotator, memory independent of m.
-  */
-sealed abstract class Arch(val name: String, val id: Int)
-object Arch {
-  case object Seed   extends Arch("seed", 0)
-  case object Stream extends Arch("stream", 1)
-  val all: Seq[Arch] = Seq(Seed, Stream)
-  def fromName(name: String): Arch =
-    all.find(_.name == name).getOrElse(
-      throw new IllegalArgumentException(s"arch must be one of ${all.map(_.name).mkString(", ")}, got arch = $name")
-    )
-}
-
 /** How the coordinate memories are built (see [[RegisteredReadMemory]]).
   *
   *  - [[MemoryStyle.Inferred]]: a `SyncReadMem`, every output register in the
@@ -32,10 +12,22 @@ object Arch {
   *    builds it from DP16KD with the output register on (scripts/fpga/ecp5). The
   *    same registers, the same cycles: simulation and proofs do not change.
   */
-sealed abstract class MemoryStyle(val name: String)
+sealed abstract class MemoryStyle(val name: String) {
+  /** The module of one coordinate memory in the emitted Verilog. */
+  def moduleName(rows: Int, width: Int): String
+
+  /** Cycles from a read's row to its data (see [[CoordinateMemory]]). */
+  def readLatency: Int
+}
 object MemoryStyle {
-  case object Inferred           extends MemoryStyle("inferred")
-  case object Ecp5OutputRegister extends MemoryStyle("ecp5-outreg")
+  case object Inferred extends MemoryStyle("inferred") {
+    def moduleName(rows: Int, width: Int): String = s"mem_${rows}x$width" // firtool's name for a SyncReadMem
+    def readLatency = 1
+  }
+  case object Ecp5OutputRegister extends MemoryStyle("ecp5-outreg") {
+    def moduleName(rows: Int, width: Int): String = s"${RegisteredReadMemory.namePrefix}${rows}x$width"
+    def readLatency: Int = RegisteredReadMemory.readLatency
+  }
   val all: Seq[MemoryStyle] = Seq(Inferred, Ecp5OutputRegister)
   def fromName(name: String): MemoryStyle =
     all.find(_.name == name).getOrElse(
@@ -69,12 +61,12 @@ object MemoryStyle {
   */
 case class AccelParams(
   m: Int = 8,
-  capacity: Int = AccelParams.defaultCapacity(8),
+  capacity: Int = Arch.Stream.defaultCapacity(8), // either architecture's default at m = 8
   keyWidth: Int = 32,
   resultQueueDepth: Int = 16,
   memoryOutputStages: Int = 2,
   debugPort: Boolean = false,
-  arch: Arch = Arch.Seed,
+  arch: Arch = Arch.Stream,
   counterWidth: Int = 64,
   batchCells: Int = 64,
   faults: Set[Fault] = Set.empty,
@@ -82,10 +74,8 @@ case class AccelParams(
 ) {
   require(m >= 1, s"parallelism m must be at least 1, got m = $m")
   require(capacity >= 2, s"capacity must be at least 2 objects, got capacity = $capacity")
-  require(
-    arch != Arch.Seed || capacity % m == 0,
-    s"capacity must be a multiple of m so the objects stripe evenly: capacity = $capacity, m = $m"
-  )
+  private val capacityProblem = arch.capacityProblem(m, capacity)
+  require(capacityProblem.isEmpty, capacityProblem.getOrElse(""))
   require(
     memoryOutputStages >= 0 && memoryOutputStages <= 4,
     s"memoryOutputStages must lie in 0..4, got $memoryOutputStages"
@@ -106,32 +96,17 @@ case class AccelParams(
   /** Rows of each of the m striped memories of the seed architecture. */
   val depth: Int = (capacity / m).max(1)
 
-  /** Whether a batch loads its next cell while the current one runs (see
-    * [[BatchControl]]). The stream's memory then holds two banks of
-    * `capacity` rows, one written while the other is read. The seed keeps
-    * one: its memories already cost 6m block RAMs, the budget that caps its m.
-    */
-  val overlapsLoads: Boolean = arch == Arch.Stream
-
-  /** Whether runs may be bipartite (a split in [[RunRequest]]): the stream's
-    * reader jumps over the objects of A a block does not test; the seed's
-    * schedule has no such jump, and refuses a split with an error.
-    */
-  val bipartiteRuns: Boolean = arch == Arch.Stream
-
-  /** Objects 0 .. headObjects-1 of a run start it from registers: the seed's
-    * block-0 A objects (m), the stream's head registers (m + 1: block 0's A
-    * objects and its window).
-    */
-  val headObjects: Int = if (arch == Arch.Stream) m + 1 else m
+  val overlapsLoads: Boolean = arch.overlapsLoads
+  val bipartiteRuns: Boolean = arch.bipartiteRuns
+  val headObjects: Int       = arch.headObjects(m)
 
   /** Bits of an object index 0 .. capacity-1. */
   val indexWidth: Int = log2Ceil(capacity).max(1)
 
-  /** Rows of each coordinate memory: the seed's striped ones, or the stream's
-    * single one, two banks of 2^indexWidth rows (a row is the bank bit over the index).
-    */
-  val memoryRows: Int = if (arch == Arch.Stream) 2 << indexWidth else depth
+  /** The coordinate memories (see [[Arch.memoryCount]]). */
+  val memoryCount: Int = arch.memoryCount(this)
+  val memoryRows: Int  = arch.memoryRows(this)
+  val memoryWidth: Int = arch.memoryWidth(this)
 
   require(
     memoryStyle != MemoryStyle.Ecp5OutputRegister || memoryRows <= RegisteredReadMemory.maxEcp5Rows,
@@ -157,16 +132,8 @@ case class AccelParams(
     */
   val readLatency: Int = 1 + memoryOutputStages + 1
 
-  /** Cycles from an issue to its hit mask at the result queue. Seed: memory
-    * read, memory output registers, rotator register, comparator register, AND
-    * register. Stream: the operands are already registers; the lanes' lag
-    * (they act StreamEngine.LaneLag cycles after the control, see its
-    * replicatedEnable), comparator register, AND register.
-    */
-  val pipelineLatency: Int = arch match {
-    case Arch.Seed   => 1 + memoryOutputStages + 3
-    case Arch.Stream => StreamEngine.LaneLag + 2
-  }
+  /** Cycles from an issue to its hit mask at the result queue. */
+  val pipelineLatency: Int = arch.pipelineLatency(this)
 
   /** Cycles a run of n >= 2 objects takes after its issue cycles when the
     * consumer never stalls: the pipeline's latency plus the cycle that sees it
@@ -174,16 +141,10 @@ case class AccelParams(
     */
   val runOverheadCycles: Int = pipelineLatency + 1
 
-  /** Cycles between the start and the first issue of a run of n >= 2
-    * objects. Stream: the first readLatency reads travel to the window's
-    * entry; the window and block 0's A objects are copied from the head
-    * registers meanwhile.
-    */
-  def startupCycles(n: Long): Long = arch match {
-    case Arch.Seed                => 0
-    case Arch.Stream if n < 2     => 0
-    case Arch.Stream              => readLatency.toLong
-  }
+  /** Cycles between the start and the first issue of any run of n >= 2 objects. */
+  val startupLatency: Int = arch.startupLatency(this)
+
+  def startupCycles(n: Long): Long = if (n < 2) 0 else startupLatency.toLong
 
   /** Every cycle of a run of n objects beyond issues and stalls. */
   def fixedCycles(n: Long): Long = if (n < 2) 0 else startupCycles(n) + runOverheadCycles
@@ -199,8 +160,6 @@ case class AccelParams(
 }
 
 object AccelParams {
-  /** Rows per memory when no capacity is given: one block RAM's worth. */
+  /** Rows per seed memory when no capacity is given: one block RAM's worth. */
   val defaultRows: Int = 256
-
-  def defaultCapacity(m: Int): Int = defaultRows * m
 }

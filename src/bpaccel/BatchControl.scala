@@ -43,9 +43,9 @@ class BatchControl(p: AccelParams) extends Module {
   })
 
   // The queue's head is held in registers of its own (`current`), so that
-  // load-ready is a flip-flop: the load's ready fans out to the engine's
-  // window enables, and a count read from the queue's memory, compared with
-  // the boxes admitted, cost stream m = 8 a third of its clock (114 -> 71 MHz).
+  // load-ready, which fans out to the engine's window enables, is a
+  // flip-flop, not a count read from the queue's memory and compared with
+  // the boxes admitted (docs/fpga.md).
   // The tail flows through when empty, so head + tail hold `batchCells`
   // counts and every count reaches the head in the cycle it would have
   // reached the head of a single queue.
@@ -69,10 +69,9 @@ class BatchControl(p: AccelParams) extends Module {
   io.cells.ready := tailIn.ready && takesCount
   val tail = Queue(tailIn, p.batchCells - 1, flow = true) // no entries: a wire
   // Whether the tail offers a count, from a register (the queue held one at
-  // the cycle's start) or the count flowing through: the queue's own valid
-  // compares its pointers, and with overlapped loads every count taken
-  // clears the loader (stream m = 32's critical path at 597e8e6, 100.2 MHz:
-  // tail pointers -> take -> the loader's and the engine's clear).
+  // the cycle's start) or the count flowing through, not the queue's own
+  // valid, which compares its pointers: with overlapped loads every count
+  // taken clears the loader and the engine.
   val tailHolds = RegInit(false.B)
   val tailValid = tailHolds || tailIn.valid
   assert(tailValid === tail.valid, "the tail queue's registered non-empty flag is wrong")

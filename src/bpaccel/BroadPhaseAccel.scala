@@ -27,6 +27,7 @@ import chisel3.util._
   * duplicated.
   */
 class BroadPhaseAccel(val p: AccelParams) extends Module {
+  override def desiredName: String = BroadPhaseAccel.topName
   val io = IO(new Bundle {
     val load     = Flipped(Decoupled(new Aabb(p.keyWidth)))
     val start    = Flipped(Decoupled(new RunRequest(p)))
@@ -41,10 +42,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   val loader  = Module(new Loader(p))
   val control = Module(new RunControl(p))
   val batch   = Module(new BatchControl(p))
-  val engine = p.arch match {
-    case Arch.Seed   => Module(new SeedEngine(p))
-    case Arch.Stream => Module(new StreamEngine(p))
-  }
+  val engine  = Module(p.arch.engine(p))
   // A beat that meets an empty queue and a ready consumer passes in the same cycle.
   val queue = Module(new Queue(new ResultBeat(p), p.resultQueueDepth, flow = true))
 
@@ -65,9 +63,9 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   val clear = start.fire || (if (p.overlapsLoads) batch.io.take.valid else batch.io.begin)
 
   // A start or a batch's first count in the same cycle wins, so a box is never loaded into the next run by accident.
-  // `offered` is the same without that term, for the engine's look-aheads:
-  // the host's start and count reached the head chain's enable copies
-  // through the load port's ready (stream m = 64's critical path, 78.8 MHz).
+  // `offered` is the same without that term, for the engine's look-aheads,
+  // so that the host's start and count do not reach the head chain's enable
+  // copies through the load port's ready.
   val loadOpen = Mux(batch.io.active, batch.io.loadReady, !control.io.status.busy)
   io.load.ready := loadOpen && (batch.io.active || !io.start.valid && !io.cells.valid)
   loader.io.offered    := io.load.valid && loadOpen
@@ -92,9 +90,9 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   engine.io.headPad       := loader.io.headPad
   engine.io.launch  := control.io.launch
   // Credits: result-queue entries neither occupied nor claimed by a cycle in
-  // flight. They are kept in a register, because the check computed from the
-  // queue's pointers (count + in flight + 1 < depth) sat in front of the
-  // engine's enable look-ahead (stream m = 32's critical path, 98.1 MHz).
+  // flight, kept in a register so that no compare of the queue's pointers
+  // (count + in flight + 1 < depth) sits in front of the engine's enable
+  // look-ahead.
   // Occupied + claimed grows by at most one a cycle, so two credits now mean
   // room for one more issue in the next cycle.
   val credits = RegInit(creditedEntries.U(log2Ceil(creditedEntries + 1).W))
@@ -117,10 +115,10 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   io.result <> queue.io.deq
   if (p.has(Fault.DropBeatWhenNotReady)) queue.io.deq.ready := true.B
 
-  // The popcount gets its own register: at m = 32 popcount + 64-bit add was
-  // the critical path (80.7 MHz). The engine counts groups of lanes beside
-  // the mask, so only their sum is left here. The count still lands by the
-  // time done rises, which is at least one cycle after the last beat was queued.
+  // The popcount gets its own register, apart from the 64-bit add, and the
+  // engine counts groups of lanes beside the mask, so only their sum is
+  // left here. The count still lands by the time done rises, which is at
+  // least one cycle after the last beat was queued.
   control.io.queuedHits := Pipe(queue.io.enq.fire, Engine.sumHitCounts(p.m, engine.io.outHitCounts))
   control.io.queueEmpty       := queue.io.count === 0.U
 
@@ -132,16 +130,7 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
   io.status.cellsDone := batch.io.cellsDone
   io.counters := control.io.counters
 
-  io.info.arch              := p.arch.id.U
-  io.info.m                 := p.m.U
-  io.info.capacity          := p.capacity.U
-  io.info.keyWidth          := p.keyWidth.U
-  io.info.runOverheadCycles := p.runOverheadCycles.U
-  io.info.readLatency       := (if (p.arch == Arch.Stream) p.readLatency else 0).U
-  io.info.batchCells        := p.batchCells.U
-  io.info.cellTagWidth      := p.cellTagWidth.U
-  io.info.batchOverlapsLoads := p.overlapsLoads.B
-  io.info.bipartiteRuns      := p.bipartiteRuns.B
+  io.info := AccelInfo(p)
 
   io.debug.foreach(_ := engine.io.probe.get)
 
@@ -150,6 +139,9 @@ class BroadPhaseAccel(val p: AccelParams) extends Module {
 }
 
 object BroadPhaseAccel {
+  /** The top module's name in the emitted Verilog. */
+  val topName = "BroadPhaseAccel"
+
   /** The message of the design's own check that credits never let a beat meet a full result queue. */
   val ResultQueueOverflow = "result queue overflow: credit accounting is broken"
 }

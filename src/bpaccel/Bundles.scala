@@ -1,6 +1,7 @@
 package bpaccel
 
 import chisel3._
+import chisel3.experimental.BundleLiterals._
 import chisel3.util._
 
 /** One axis-aligned bounding box as six order-preserving keys. */
@@ -111,6 +112,22 @@ class AccelInfo extends Bundle {
   val bipartiteRuns     = Bool()     // starts and cells may carry a split (RunRequest)
 }
 
+object AccelInfo {
+  /** The info port's constants: the parameters the C header carries too. */
+  def apply(p: AccelParams): AccelInfo = (new AccelInfo).Lit(
+    _.arch               -> p.arch.id.U,
+    _.m                  -> p.m.U,
+    _.capacity           -> p.capacity.U,
+    _.keyWidth           -> p.keyWidth.U,
+    _.runOverheadCycles  -> p.runOverheadCycles.U,
+    _.readLatency        -> p.startupLatency.U,
+    _.batchCells         -> p.batchCells.U,
+    _.cellTagWidth       -> p.cellTagWidth.U,
+    _.batchOverlapsLoads -> p.overlapsLoads.B,
+    _.bipartiteRuns      -> p.bipartiteRuns.B
+  )
+}
+
 /** The ports every architecture's engine offers the shared top level. */
 class EngineIO(p: AccelParams) extends Bundle {
   val write    = Flipped(Valid(new LoadWrite(p)))
@@ -135,6 +152,21 @@ class HitSummary(m: Int) extends Bundle {
 }
 
 object Engine {
+  /** The AND stage's registers: each lane's hit, whether any lane hit, and
+    * the hits counted by groups of lanes. The OR of the lanes is taken before
+    * the register, so that no OR tree sits between the last stage and the
+    * result queue's write; the group counts keep half the popcount off the
+    * path from the mask to the hit counter (docs/fpga.md). Only for an
+    * engine whose compares are registered before the AND.
+    */
+  def hitRegisters(m: Int, hits: UInt): HitSummary = {
+    val summary = Wire(new HitSummary(m))
+    summary.mask := hits
+    summary.any  := hits.orR
+    for ((count, lanes) <- summary.counts.zip(hits.asBools.grouped(HitCountGroup))) count := PopCount(lanes)
+    RegNext(summary)
+  }
+
   /** Lanes per partial hit count: an 8-bit popcount is a few LUT4 levels. */
   val HitCountGroup = 8
   private def groupSizes(m: Int): Seq[Int] = (0 until m by HitCountGroup).map(g => (m - g).min(HitCountGroup))
@@ -165,33 +197,15 @@ abstract class Engine(val p: AccelParams) extends Module {
     */
   protected val advance = RegNext(io.room, false.B)
 
-  /** The AND stage's registers: each lane's hit, whether any lane hit, and
-    * the hits counted by groups of lanes. The OR of the lanes is taken before
-    * the register, so that no OR tree sits between the last stage and the
-    * result queue's write (stream m = 32's critical path, 106.5 MHz: the hit
-    * mask's OR into the queue). The group counts likewise keep half the
-    * popcount off the path from the mask to the hit counter (stream m = 64's
-    * critical path, 90.8 MHz: the 64-bit popcount in one cycle, 13 LUT
-    * levels). Only for an engine whose compares are registered before the AND.
-    */
-  protected def hitRegisters(hits: UInt): HitSummary = {
-    val summary = Wire(new HitSummary(p.m))
-    summary.mask   := hits
-    summary.any    := hits.orR
-    for ((count, lanes) <- summary.counts.zip(hits.asBools.grouped(Engine.HitCountGroup))) count := PopCount(lanes)
-    RegNext(summary)
-  }
-
   /** Drives the result and the debug probe from the pipeline's last stage.
     *
     * The hit and lane masks go out by lane of the engine, with no logic
     * between the AND stage's registers and the result queue: an engine
     * whose lanes hold the run's objects from a lane d other than 0 (the
     * stream's short runs) gives bases already moved down by d, modulo
-    * 2^indexWidth (see [[ScheduleBeat]]). Until this, `emit` shifted both
-    * masks down by d lanes here, one mux level per bit of d across all m
-    * lanes, and that shift was the FPGA's critical path (docs/fpga.md).
-    * Probe lane k is engine lane k, as the mask's bit k is.
+    * 2^indexWidth (see [[ScheduleBeat]]), so no shift of the masks by d
+    * lanes sits here (docs/fpga.md). Probe lane k is engine lane k, as the
+    * mask's bit k is.
     */
   protected def emit(
     valid: Bool,

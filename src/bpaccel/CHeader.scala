@@ -1,9 +1,71 @@
 package bpaccel
 
-/** The C header that tells the host which hardware it drives. Written from the
-  * same [[AccelParams]] the Verilog comes from, so the two cannot disagree.
+/** Every generated parameter the host, the Makefile and the FPGA scripts
+  * read, listed once: the C header and `bpaccel_params.json` both render this
+  * list, so they cannot disagree with each other or with the Verilog.
+  * Names are lower snake case (the header's macros are BPACCEL_ and the name
+  * in upper case).
   */
+object GeneratedParams {
+  sealed trait Value
+  final case class Number(value: Long)    extends Value
+  final case class Flag(value: Boolean)   extends Value
+  final case class Text(value: String)    extends Value
+
+  def apply(p: AccelParams): Seq[(String, Value)] = Seq(
+    "arch"                 -> Text(p.arch.name),
+    "arch_id"              -> Number(p.arch.id),
+    "arch_stream"          -> Flag(p.arch == Arch.Stream),
+    "m"                    -> Number(p.m),
+    "capacity"             -> Number(p.capacity),
+    "default_capacity"     -> Number(p.arch.defaultCapacity(p.m)),
+    "key_width"            -> Number(p.keyWidth),
+    "index_width"          -> Number(p.indexWidth),
+    "count_width"          -> Number(p.countWidth),
+    "result_queue_depth"   -> Number(p.resultQueueDepth),
+    "pipeline_latency"     -> Number(p.pipelineLatency),
+    "run_overhead_cycles"  -> Number(p.runOverheadCycles),
+    "read_latency"         -> Number(p.startupLatency),
+    "debug_port"           -> Flag(p.debugPort),
+    "batch_cells"          -> Number(p.batchCells),
+    "cell_tag_width"       -> Number(p.cellTagWidth),
+    "batch_overlaps_loads" -> Flag(p.overlapsLoads),
+    "bipartite_runs"       -> Flag(p.bipartiteRuns),
+    "head_objects"         -> Number(p.headObjects),
+    "memory_style"         -> Text(p.memoryStyle.name),
+    "memory_output_stages" -> Number(p.memoryOutputStages),
+    "memory_module"        -> Text(p.memoryStyle.moduleName(p.memoryRows, p.memoryWidth)),
+    "memory_count"         -> Number(p.memoryCount),
+    "memory_rows"          -> Number(p.memoryRows),
+    "memory_width"         -> Number(p.memoryWidth),
+    "top"                  -> Text(BroadPhaseAccel.topName),
+    "fingerprint"          -> Text(CHeader.fingerprint(p))
+  )
+
+  /** Run error codes by name (`load_overflow` ...). */
+  def errors: Seq[(String, Int)] = AccelError.names.map { case (name, e) => name.toLowerCase -> AccelError.code(e) }
+}
+
+/** `bpaccel_params.json`: [[GeneratedParams]] for scripts, with the error codes under "errors". */
+object ParamsJson {
+  val fileName = "bpaccel_params.json"
+  val schema   = "bpaccel-params-1"
+
+  def apply(p: AccelParams): String = {
+    val fields = GeneratedParams(p).map {
+      case (name, GeneratedParams.Number(v)) => name -> ujson.Num(v.toDouble)
+      case (name, GeneratedParams.Flag(v))   => name -> ujson.Bool(v)
+      case (name, GeneratedParams.Text(v))   => name -> ujson.Str(v)
+    }
+    val errors = ujson.Obj.from(GeneratedParams.errors.map { case (name, code) => name -> ujson.Num(code) })
+    ujson.write(ujson.Obj.from(("schema" -> ujson.Str(schema)) +: fields :+ ("errors" -> errors)), indent = 2) + "\n"
+  }
+}
+
+/** The C header that tells the host which hardware it drives. */
 object CHeader {
+  val fileName = "bpaccel_params.h"
+
   /** One string that names the whole configuration; the host compares it. */
   def fingerprint(p: AccelParams): String =
     s"arch=${p.arch.name},m=${p.m},capacity=${p.capacity},key_width=${p.keyWidth},queue=${p.resultQueueDepth}," +
@@ -23,27 +85,12 @@ object CHeader {
   }
 
   def apply(p: AccelParams): String = {
-    val defines = Seq(
-      "ARCH"                -> s"\"${p.arch.name}\"",
-      "ARCH_ID"             -> p.arch.id.toString,
-      "ARCH_STREAM"         -> (if (p.arch == Arch.Stream) "1" else "0"),
-      "M"                   -> p.m.toString,
-      "CAPACITY"            -> p.capacity.toString,
-      "KEY_WIDTH"           -> p.keyWidth.toString,
-      "INDEX_WIDTH"         -> p.indexWidth.toString,
-      "COUNT_WIDTH"         -> p.countWidth.toString,
-      "RESULT_QUEUE_DEPTH"  -> p.resultQueueDepth.toString,
-      "PIPELINE_LATENCY"    -> p.pipelineLatency.toString,
-      "RUN_OVERHEAD_CYCLES" -> p.runOverheadCycles.toString,
-      "READ_LATENCY"        -> (if (p.arch == Arch.Stream) p.readLatency else 0).toString,
-      "DEBUG_PORT"          -> (if (p.debugPort) "1" else "0"),
-      "BATCH_CELLS"         -> p.batchCells.toString,
-      "CELL_TAG_WIDTH"      -> p.cellTagWidth.toString,
-      "BATCH_OVERLAPS_LOADS" -> (if (p.overlapsLoads) "1" else "0"),
-      "BIPARTITE_RUNS"      -> (if (p.bipartiteRuns) "1" else "0"),
-      "FINGERPRINT"         -> s"\"${fingerprint(p)}\""
-    ) ++ AccelError.names.map { case (name, e) => s"ERROR_$name" -> AccelError.code(e).toString }
-    val body = defines.map { case (k, v) => s"#define BPACCEL_$k $v" }.mkString("\n")
+    val defines = GeneratedParams(p).map {
+      case (name, GeneratedParams.Number(v)) => name -> v.toString
+      case (name, GeneratedParams.Flag(v))   => name -> (if (v) "1" else "0")
+      case (name, GeneratedParams.Text(v))   => name -> s"\"$v\""
+    } ++ GeneratedParams.errors.map { case (name, code) => s"error_$name" -> code.toString }
+    val body = defines.map { case (k, v) => s"#define BPACCEL_${k.toUpperCase} $v" }.mkString("\n")
     s"""/* Generated by bpaccel.EmitVerilog from ${describe(p)}; do not edit. */
        |#ifndef BPACCEL_PARAMS_H
        |#define BPACCEL_PARAMS_H
@@ -60,8 +107,7 @@ object CHeader {
        | * A run of n >= 2 objects with a consumer that never stalls takes
        | * startup(n) + issue_cycles(n) + BPACCEL_RUN_OVERHEAD_CYCLES cycles, where
        | * issue_cycles(n) = sum over b = 0 .. (n-2)/M of (n - 1 - b*M) and
-       | * startup(n) = 0 for the seed architecture, BPACCEL_READ_LATENCY for
-       | * the stream architecture;
+       | * startup(n) = BPACCEL_READ_LATENCY (0 for the seed architecture);
        | * runs with n < 2 take no cycles.
        | * Bipartite runs (BPACCEL_BIPARTITE_RUNS): start and cells carry
        | * {count, split}; split = 0 runs all pairs, split = na in 1 .. n-1 only

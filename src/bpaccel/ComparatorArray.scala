@@ -5,9 +5,8 @@ import chisel3._
 /** 3m greater-or-equal and 3m less-or-equal comparators: lane k's six
   * results say, axis by axis, whether a(k) and b(k) overlap. Overlap is
   * inclusive on every axis (touching boxes overlap), as in Bullet's test.
-  * Both architectures register the six results before the AND: a 32-bit
-  * compare's carry chain and the AND in one stage were seed m = 8's critical
-  * path (116.9 MHz, 32 carry cells and 4 LUT levels).
+  * Both architectures register the six results before the AND, so a 32-bit
+  * compare's carry chain and the AND are not one stage.
   */
 class ComparatorArray(p: AccelParams) extends Module {
   val io = IO(new Bundle {

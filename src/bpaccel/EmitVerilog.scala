@@ -5,9 +5,10 @@ import java.nio.file.{Files, Path, Paths}
 import chisel3.stage.ChiselGeneratorAnnotation
 import circt.stage.{ChiselStage, FirtoolOption}
 
-/** Emits the SystemVerilog of one configuration plus its C header.
+/** Emits the SystemVerilog of one configuration plus its C header and
+  * parameter file (bpaccel_params.h, bpaccel_params.json).
   *
-  * Usage: EmitVerilog --m 16 --capacity 4096 --target-dir generated/m16
+  * Usage: EmitVerilog --arch stream --m 16 --capacity 4096 --target-dir generated/stream-m16
   */
 object EmitVerilog {
   /** Raw command-line values; turned into [[AccelParams]] (and checked) once all are read. */
@@ -23,18 +24,20 @@ object EmitVerilog {
     memoryStyle: String = AccelParams().memoryStyle.name,
     targetDir: Path = Paths.get("generated")
   ) {
-    def params: AccelParams =
+    def params: AccelParams = {
+      val a = Arch.fromName(arch)
       AccelParams(
         m,
-        capacity.getOrElse(AccelParams.defaultCapacity(m)),
+        capacity.getOrElse(a.defaultCapacity(m)),
         keyWidth,
         queueDepth,
         memoryOutputStages,
         debugPort,
-        Arch.fromName(arch),
+        a,
         batchCells = batchCells,
         memoryStyle = MemoryStyle.fromName(memoryStyle)
       )
+    }
   }
 
   /** firtool options that keep the output plain enough for Yosys, Verilator and vendor tools.
@@ -62,15 +65,26 @@ object EmitVerilog {
       Array("--target", "systemverilog", "--split-verilog", "--target-dir", targetDir.toString),
       Seq(ChiselGeneratorAnnotation(() => new BroadPhaseAccel(p))) ++ firtoolOptions.map(FirtoolOption(_))
     )
+    finishCore(p, targetDir)
+    Files.writeString(targetDir.resolve(lintWaivers), lintWaiverText)
+    targetDir.resolve("filelist.f")
+  }
+
+  /** What every emission holding the core of `p` gets after firtool: its
+    * memories rewritten for block RAM, the architecture's checks, and the C
+    * header and parameter file.
+    */
+  def finishCore(p: AccelParams, targetDir: Path): Unit = {
     // One clock port per memory, so each maps to block RAM when synthesised on its own.
     SingleClockMemories.rewrite(targetDir)
     // No read meets a write at the same row, so the block RAM needs no collision bypass.
     NoCollisionMemories.rewrite(targetDir)
-    // Each lane's registers under their own lane's enables (a firtool miscompile this has seen).
-    LaneEnables.check(p, targetDir)
-    Files.writeString(targetDir.resolve("bpaccel_params.h"), CHeader(p))
-    Files.writeString(targetDir.resolve(lintWaivers), lintWaiverText)
-    targetDir.resolve("filelist.f")
+    p.arch.checkEmitted(p, targetDir)
+    val memory = p.memoryStyle.moduleName(p.memoryRows, p.memoryWidth)
+    if (!SingleClockMemories.listedFiles(targetDir).exists(_.getFileName.toString == s"$memory.sv"))
+      throw new IllegalStateException(s"EmitVerilog: no $memory.sv in $targetDir/filelist.f, which the parameter file names")
+    Files.writeString(targetDir.resolve(CHeader.fileName), CHeader(p))
+    Files.writeString(targetDir.resolve(ParamsJson.fileName), ParamsJson(p))
   }
 
   /** Verilator configuration for `verilator --lint-only -Wall lint_waivers.vlt -F filelist.f`. */
@@ -91,7 +105,7 @@ object EmitVerilog {
       opt[Int]("m").action((v, o) => o.copy(m = v)).text("parallelism: pair tests per cycle")
       opt[Int]("capacity")
         .action((v, o) => o.copy(capacity = Some(v)))
-        .text(s"objects per run, a multiple of m (default ${AccelParams.defaultRows} * m)")
+        .text(s"objects per run (default: the architecture's, ${Arch.all.map(a => s"${a.name} ${a.defaultCapacity(AccelParams().m)}").mkString(", ")} at m = ${AccelParams().m}; seed: a multiple of m)")
       opt[Int]("key-width").action((v, o) => o.copy(keyWidth = v)).text("bits per coordinate key")
       opt[Int]("queue-depth").action((v, o) => o.copy(queueDepth = v)).text("result queue beats")
       opt[Int]("memory-output-stages")
@@ -123,7 +137,7 @@ object EmitVerilog {
               sys.exit(2)
           }
         val out = emit(params, o.targetDir)
-        println(s"wrote $out and ${o.targetDir.resolve("bpaccel_params.h")} for $params")
+        println(s"wrote $out, ${CHeader.fileName} and ${ParamsJson.fileName} for $params")
       case None => sys.exit(2)
     }
   }

@@ -2,7 +2,7 @@ package bpaccel
 
 import java.nio.file.{Files, Path}
 
-/** Checks, in the emitted StreamEngine.sv, that each lane register of the
+/** Checks, in the emitted StreamLanes.sv, that each lane register of the
   * stream engine (lane k of the window, `aNext`, `a` and the head chain) is
   * assigned only under enable copies of its own lane (`*_replica<k>`).
   *
@@ -15,6 +15,8 @@ import java.nio.file.{Files, Path}
   * broken lane.
   */
 object LaneEnables {
+  /** The emitted module that holds the lanes ([[StreamLanes]]). */
+  val file = "StreamLanes.sv"
   private val AlwaysBlock = """(?s)always @\(posedge clock\) begin(.*?)end // always @\(posedge\)""".r
   private val LaneAssignment = """\b(window|aNext|a|headRegs)_(\d+)_\w+\s*<=""".r
   private val EnableCopy = """\b(\w+)_replica(\d+)\b""".r
@@ -39,8 +41,7 @@ object LaneEnables {
     } yield s"${reg}_${k}_box"
 
   /** Throws naming the first wrong lane, for a stream configuration's emitted folder. */
-  def check(p: AccelParams, dir: Path): Unit = if (p.arch == Arch.Stream) {
-    val file = "StreamEngine.sv"
+  def check(p: AccelParams, dir: Path): Unit = {
     val text = Files.readString(dir.resolve(file))
     for ((reg, copy) <- mismatches(text).headOption)
       throw new IllegalStateException(

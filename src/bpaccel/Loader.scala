@@ -19,8 +19,7 @@ class LoadWrite(p: AccelParams) extends Bundle {
 }
 
 /** A batch cell's box count, with what the front end tests of it decided as
-  * the count is queued: the OR tree behind the queue's LUT RAM was stream
-  * m = 32's critical path (84.7 MHz).
+  * the count is queued, so that no OR tree sits behind the queue's LUT RAM.
   */
 class CellCount(p: AccelParams) extends Bundle {
   val count    = UInt(p.countWidth.W)

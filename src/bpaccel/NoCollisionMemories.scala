@@ -7,21 +7,27 @@ import scala.util.matching.Regex
 /** Tells synthesis that no memory is read and written at the same row in the
   * same cycle, so it need not build the collision behaviour.
   *
-  * firtool emits each `SyncReadMem` as a registered read address, which
-  * Yosys reads as a write-first (transparent) read, and a block RAM's read
-  * and write ports give no such guarantee against each other: Yosys then
-  * adds a bypass (the last write's data and row, a row compare and a
-  * multiplexer on every read bit) after the block RAM. At seed m = 8 that is
-  * about 45 LUT4 and 50 flip-flops per memory, 48 memories, and the
-  * multiplexer sat between the block RAM and the rotator's input register
-  * (the critical path, 110.1 MHz). Both engines assert that a read whose
-  * data they use never meets a write (see `readsNeverMeetWrites` in
-  * [[SeedEngine]] and [[StreamEngine]]), so `(* no_rw_check *)` on the array
-  * is true, and Yosys then maps the memory to the block RAM alone. Vendor
-  * tools ignore the attribute, as Debian's Yosys 0.23 (the Xilinx estimate) does.
+  * firtool emits each `SyncReadMem` as a registered read address and a read
+  * of the array, which synthesis reads as a write-first (transparent) read,
+  * and a block RAM's read and write ports give no such guarantee against
+  * each other: a tool then adds a bypass after the block RAM (the last
+  * write's data and row, a row compare and a multiplexer on every read bit;
+  * at seed m = 8 about 45 LUT4 and 50 flip-flops per memory, 48 memories, in
+  * front of the rotator). Both engines assert that a read whose data they
+  * use never meets a write (`readsNeverMeetWrites` in [[SeedEngine]],
+  * [[StreamReader]]), so each memory array gets the attribute every major
+  * tool reads as "no read-during-write check":
+  *
+  *  - `ramstyle = "no_rw_check"`: Intel Quartus, and Yosys;
+  *  - `syn_ramstyle = "no_rw_check"`: Synopsys Synplify (Lattice Diamond and
+  *    Radiant, Microchip Libero), and Yosys;
+  *  - `rw_addr_collision = "no"`: AMD Vivado (its default for this shape
+  *    adds no bypass either).
+  *
+  * Each keeps the tool's own choice of RAM kind.
   */
 object NoCollisionMemories {
-  val attribute = "(* no_rw_check *)"
+  val attribute = """(* ramstyle = "no_rw_check", syn_ramstyle = "no_rw_check", rw_addr_collision = "no" *)"""
 
   /** The one array declaration of a firtool memory module: `reg [w:0] Memory[0:d];`. */
   private val ArrayDeclaration = """(?m)^(\s*)(reg\s+\[[^\]]+\]\s+Memory\s*\[[^\]]+\]\s*;)""".r

@@ -26,7 +26,7 @@ import chisel3.util._
 class RegisteredReadMemory(val rows: Int, val width: Int) extends Module {
   require(rows >= 1 && width >= 1, s"RegisteredReadMemory needs rows >= 1 and width >= 1, got $rows x $width")
   private val rowBits = log2Ceil(rows).max(1)
-  override def desiredName: String = s"${RegisteredReadMemory.namePrefix}${rows}x$width"
+  override def desiredName: String = MemoryStyle.Ecp5OutputRegister.moduleName(rows, width)
 
   val io = IO(new Bundle {
     val writeEnable = Input(Bool())

@@ -59,8 +59,8 @@ class RunControl(p: AccelParams) extends Module {
   // cycle that accepts its start, pauses included, since the device belongs
   // to that run from its first box on. Published in loadCycles at the start.
   // Kept as the value a start in this cycle would publish (the start cycle
-  // included), so that the start adds one register to the counter: two
-  // 64-bit adds in series were seed m = 8's critical path (106.1 MHz).
+  // included), so that the start adds one register to the counter, not two
+  // 64-bit adds in series.
   val loading          = RegInit(false.B)
   val loadCyclesAtStart = RegInit(1.U(p.counterWidth.W))
   val drainCycles   = RegInit(0.U(log2Ceil(p.runOverheadCycles + 1).W))
@@ -115,9 +115,9 @@ class RunControl(p: AccelParams) extends Module {
   }
 
   // The issue and stall counts take the engine's flags a cycle late, from
-  // registers of their own: `issue` drove these 128 flip-flops directly and
-  // pulled its LUT away from the engine's control (stream m = 128's critical
-  // path, 60.6 MHz). The last issue or stall of a run comes at least
+  // registers of their own, so that `issue` does not drive these 128
+  // flip-flops and pull its LUT away from the engine's control. The last
+  // issue or stall of a run comes at least
   // pipelineLatency cycles before its done, so its count lands while busy.
   val issuedLate  = RegNext(io.engine.issued, false.B)
   val stalledLate = RegNext(io.engine.stalled, false.B)

@@ -66,9 +66,8 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
     assert(!(loadRead(k) && memoryWrite.bits(k)), "a block-0 read-back met a write of its row")
   // While idle every port reads row 0. The read enable is always on: a
   // read's data is used only where a capture or a schedule stage says so,
-  // and an enable computed from the run state and the read-backs reached the
-  // read enables of all 6m block RAMs (seed m = 8's critical path with the
-  // output register in the DP16KD, 92.3 MHz: loadRead -> 96 read enables).
+  // and an enable computed from the run state and the read-backs would
+  // reach the read enables of all 6m block RAMs.
   val readRows = VecInit(issue.bits.bRows.map(r => Mux(sequencer.io.active, r, 0.U)))
   buffer.io.readEnable := true.B
   buffer.io.rows       := readRows
@@ -106,13 +105,13 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   capture.tags  := tags(portObjects)
 
   // Memory read (1 cycle), then the memory output registers; the buffer's
-  // data comes CoordBuffer.readLatency cycles after the read (the first
-  // output register may sit inside the memories).
+  // data comes the memory style's readLatency cycles after the read (the
+  // first output register may sit inside the memories).
   val memoryStages = Seq.iterate(
     (Pipe(issue.valid, meta), Pipe(issue.valid || loadRead.orR, capture)),
     p.memoryOutputStages + 1
   ) { case (at, cap) => (Pipe(at), Pipe(cap)) }
-  val memData = Seq.iterate(buffer.io.data, p.memoryOutputStages + 2 - CoordBuffer.readLatency(p))(RegNext(_)).last
+  val memData = Seq.iterate(buffer.io.data, p.memoryOutputStages + 2 - p.memoryStyle.readLatency)(RegNext(_)).last
   val (atBuffered, captureAt) = memoryStages.last
 
   // The A blocks, captured from the read data.
@@ -137,7 +136,7 @@ class SeedEngine(p: AccelParams) extends Engine(p) {
   compare.io.b := rotatedB
   val compared   = RegNext(compare.io.compares)
   val atCompared = Pipe(atRotated)
-  val hits = hitRegisters(ComparatorArray.hits(compared) & atCompared.bits.laneMask)
+  val hits = Engine.hitRegisters(m, ComparatorArray.hits(compared) & atCompared.bits.laneMask)
   val atAnd  = Pipe(atCompared)
   val probeI = RegNext(RegNext(aBlockTag))
 

@@ -83,14 +83,14 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
     }
 
   private val configurations = Seq(
-    AccelParams(m = 1, capacity = 12, batchCells = 8),
-    AccelParams(m = 3, capacity = 24, batchCells = 8), // not a power of two
-    AccelParams(m = 8, capacity = 64, batchCells = 16),
-    AccelParams(m = 3, capacity = 25, arch = Arch.Stream, batchCells = 8),
-    AccelParams(m = 8, capacity = 64, arch = Arch.Stream, batchCells = 4),
+    SharedConfigs.seedM1,
+    SharedConfigs.seedM3,
+    SharedConfigs.seedM8,
+    SharedConfigs.streamM3,
+    SharedConfigs.streamM8,
     AccelParams(m = 2, capacity = 10, arch = Arch.Stream, batchCells = 1), // the head register is the whole queue
     // Loads and runs overlap in a batch: the block RAM's read and write ports must never collide.
-    AccelParams(m = 3, capacity = 24, batchCells = 8, memoryStyle = MemoryStyle.Ecp5OutputRegister),
+    AccelParams(m = 3, capacity = 24, batchCells = 8, memoryStyle = MemoryStyle.Ecp5OutputRegister, arch = Arch.Seed),
     AccelParams(m = 3, capacity = 25, arch = Arch.Stream, batchCells = 8, memoryStyle = MemoryStyle.Ecp5OutputRegister)
   )
 
@@ -288,7 +288,7 @@ class BatchSpec extends AnyFlatSpec with Simulators with Checks {
   }
 
   it should "fail its check when the front end's cell counter skips short cells (mutant)" in {
-    val p = AccelParams(m = 3, capacity = 12, batchCells = 8, faults = Set(Fault.CellCounterSkipsShortCells))
+    val p = AccelParams(m = 3, capacity = 12, batchCells = 8, faults = Set(Fault.CellCounterSkipsShortCells), arch = Arch.Seed)
     withDriver(p) { (dut, drv) =>
       val rng   = new Random(13)
       val cells = Seq(5, 1, 8, 0, 12).map(n => Box.Scenes.uniform(rng, n, p.keyWidth, 20, 10))

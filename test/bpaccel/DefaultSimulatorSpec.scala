@@ -9,7 +9,7 @@ import scala.util.Random
   */
 class DefaultSimulatorSpec extends AnyFlatSpec with Simulators with Checks {
   "On the default simulator, the accelerator" should "follow the golden schedule and report exact pairs (m=3)" in {
-    val p = AccelParams(m = 3, capacity = 12, debugPort = true)
+    val p = AccelParams(m = 3, capacity = 12, debugPort = true, arch = Arch.Seed)
     onDefaultSimulator(p) { dut =>
       val drv = new AccelDriver(dut)
       drv.idleInputs()

@@ -79,7 +79,7 @@ class GeneratedScenesSpec extends AnyFlatSpec with Simulators with Checks with S
     val rng = new Random(seed)
     Seq.fill(3) {
       val m = 1 + rng.nextInt(7)
-      AccelParams(m = m, capacity = m * (2 + rng.nextInt(5)), keyWidth = Seq(8, 16, 32)(rng.nextInt(3)))
+      AccelParams(m = m, capacity = m * (2 + rng.nextInt(5)), keyWidth = Seq(8, 16, 32)(rng.nextInt(3)), arch = Arch.Seed)
     }.distinct
   }
   info(s"configurations drawn from seed $seed (set BPACCEL_PROPERTY_SEED to draw others)")
@@ -94,7 +94,7 @@ class GeneratedScenesSpec extends AnyFlatSpec with Simulators with Checks with S
   it should "find a planted disagreement and shrink it to a small scene" in {
     // The reference forgets pairs of identical boxes: the check must fail, and
     // shrinking must bring the scene down to the two boxes that show it.
-    val p = AccelParams(m = 3, capacity = 12, keyWidth = 8)
+    val p = AccelParams(m = 3, capacity = 12, keyWidth = 8, arch = Arch.Seed)
     val wrongReference: Seq[Box] => Set[(Int, Int)] =
       boxes => Box.bruteForcePairs(boxes).filterNot { case (i, j) => boxes(i) == boxes(j) }
     val failure = intercept[TestFailedException](check(p, scenarios = 200, wrongReference))

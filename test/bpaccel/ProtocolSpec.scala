@@ -8,10 +8,7 @@ import scala.util.Random
 
 /** Errors instead of silent truncation, and recovery after runs and resets, for both architectures. */
 class ProtocolSpec extends AnyFlatSpec with Simulators with Checks {
-  private val configurations = Seq(
-    AccelParams(m = 4, capacity = 16),
-    AccelParams(m = 4, capacity = 18, arch = Arch.Stream) // the stream needs no multiple of m
-  )
+  private val configurations = Seq(SharedConfigs.seedM3, SharedConfigs.streamM3)
 
   for (p <- configurations) {
     val arch = s"(${p.arch.name})"
@@ -32,7 +29,7 @@ class ProtocolSpec extends AnyFlatSpec with Simulators with Checks {
         dut.io.info.capacity.expect(p.capacity.U)
         dut.io.info.keyWidth.expect(p.keyWidth.U)
         dut.io.info.runOverheadCycles.expect(p.runOverheadCycles.U)
-        dut.io.info.readLatency.expect((if (p.arch == Arch.Stream) p.readLatency else 0).U)
+        dut.io.info.readLatency.expect(p.startupLatency.U)
       }
     }
 

@@ -6,7 +6,6 @@ import chisel3._
 import chisel3.experimental.{IntParam, StringParam}
 import chisel3.util.{log2Ceil, HasBlackBoxPath}
 import chiseltest._
-import chiseltest.simulator.VerilatorBackendAnnotation
 import org.scalatest.flatspec.AnyFlatSpec
 import org.scalatest.matchers.should.Matchers
 
@@ -17,7 +16,7 @@ import scala.util.Random
   * replaces, cycle by cycle on Verilator, with a behavioural DP16KD model
   * (test/resources/ecp5/DP16KD.v; the tools ship only a black box).
   */
-class RegisteredReadMemorySpec extends AnyFlatSpec with ChiselScalatestTester with Matchers {
+class RegisteredReadMemorySpec extends AnyFlatSpec with Simulators with Matchers {
 
   private def file(path: String): String = Paths.get(path).toAbsolutePath.toString
 
@@ -67,7 +66,7 @@ class RegisteredReadMemorySpec extends AnyFlatSpec with ChiselScalatestTester wi
   private def mismatches(rows: Int, width: Int, regMode: String, cycles: Int, seed: Int): (Int, Int) = {
     var differ   = 0
     var compared = 0
-    test(new BothMemories(rows, width, regMode)).withAnnotations(Seq(VerilatorBackendAnnotation)) { c =>
+    onSharedVerilator("BothMemories", (rows, width, regMode))(new BothMemories(rows, width, regMode)) { c =>
       val rng       = new Random(seed)
       val rowBits   = log2Ceil(rows).max(1)
       var readsDone = 0 // enabled reads at least two cycles old

@@ -22,12 +22,21 @@ class ResultSpec extends AnyFlatSpec with Simulators with Checks {
 
   behavior of "The accelerator"
 
-  for (
-    (m, capacity, arch) <- Seq((1, 16), (2, 16), (3, 24), (4, 32), (5, 40), (8, 64)).map { case (m, c) => (m, c, Arch.Seed) } ++
-                             Seq((1, 16, Arch.Stream), (3, 25, Arch.Stream), (8, 64, Arch.Stream), (12, 48, Arch.Stream)) // 12: two hit-count groups, one short
+  private val backPressured = Seq(
+    SharedConfigs.seedM1,
+    AccelParams(m = 2, capacity = 16, arch = Arch.Seed),
+    SharedConfigs.seedM3,
+    AccelParams(m = 4, capacity = 32, arch = Arch.Seed),
+    AccelParams(m = 5, capacity = 40, arch = Arch.Seed),
+    SharedConfigs.seedM8,
+    AccelParams(m = 1, capacity = 16, arch = Arch.Stream),
+    SharedConfigs.streamM3,
+    SharedConfigs.streamM8,
+    AccelParams(m = 12, capacity = 48, arch = Arch.Stream) // two hit-count groups, one short
   )
-    it should s"report exactly the brute-force pairs under any back-pressure (m=$m, ${arch.name})" in {
-      val p = AccelParams(m = m, capacity = capacity, arch = arch)
+
+  for (p <- backPressured; m = p.m; capacity = p.capacity)
+    it should s"report exactly the brute-force pairs under any back-pressure (m=$m, ${p.arch.name})" in {
       onVerilator(p) { dut =>
         val drv = new AccelDriver(dut)
         drv.idleInputs()
@@ -61,7 +70,7 @@ class ResultSpec extends AnyFlatSpec with Simulators with Checks {
 
   for (stages <- Seq(0, 1, 3))
     it should s"report exactly the brute-force pairs with $stages memory output stages (m=3)" in {
-      val p = AccelParams(m = 3, capacity = 24, memoryOutputStages = stages)
+      val p = AccelParams(m = 3, capacity = 24, memoryOutputStages = stages, arch = Arch.Seed)
       onVerilator(p) { dut =>
         val drv = new AccelDriver(dut)
         drv.idleInputs()
@@ -74,7 +83,7 @@ class ResultSpec extends AnyFlatSpec with Simulators with Checks {
     }
 
   it should "work with narrow keys (8 bits) at the ends of their range" in {
-    val p = AccelParams(m = 4, capacity = 32, keyWidth = 8)
+    val p = AccelParams(m = 4, capacity = 32, keyWidth = 8, arch = Arch.Seed)
     onVerilator(p) { dut =>
       val drv = new AccelDriver(dut)
       drv.idleInputs()

@@ -52,17 +52,20 @@ class ScheduleHardwareSpec extends AnyFlatSpec with Simulators with Checks {
 
   behavior of "The stream architecture's schedule"
 
+  // Capacities shared with the bipartite tests below, so each m is one model (5m + 1, and 4m + 3 at m = 1).
+  private def streamCapacity(m: Int): Int = (5 * m + 1).max(4 * m + 3)
+
   for (m <- Seq(1, 2, 3, 5, 8))
     it should s"match the stream golden model for m=$m and every n up to the capacity" in {
-      scheduleAllCounts(m, capacity => 0 to capacity, capacity = 5 * m + 1, arch = Arch.Stream)
+      scheduleAllCounts(m, capacity => 0 to capacity, capacity = streamCapacity(m), arch = Arch.Stream)
     }
 
-  for (m <- Seq(13, 16))
+  for ((m, capacity) <- Seq(13 -> 3 * 13, 16 -> (3 * 16 + 2)))
     it should s"match the stream golden model for m=$m at small n, around multiples of m and at the capacity" in {
       scheduleAllCounts(
         m,
         capacity => (Seq(0, 1, 2, 3, m - 1, m, m + 1, m + 2, 2 * m - 1, 2 * m, 2 * m + 1, 2 * m + 2, capacity - 1, capacity)).distinct,
-        capacity = 3 * m,
+        capacity = capacity,
         arch = Arch.Stream
       )
     }
@@ -88,8 +91,8 @@ class ScheduleHardwareSpec extends AnyFlatSpec with Simulators with Checks {
   behavior of "The stream architecture's bipartite runs"
 
   for (m <- Seq(1, 2, 3, 4))
-    it should s"match the bipartite golden model for m=$m, every n up to the capacity and every split" in {
-      bipartiteAllSplits(m, capacity = 4 * m + 3, counts = 2 to 4 * m + 3, MemoryStyle.Inferred)
+    it should s"match the bipartite golden model for m=$m, every n up to 4m + 3 and every split" in {
+      bipartiteAllSplits(m, capacity = streamCapacity(m), counts = 2 to 4 * m + 3, MemoryStyle.Inferred)
     }
 
   for (m <- Seq(7, 16))
@@ -98,7 +101,7 @@ class ScheduleHardwareSpec extends AnyFlatSpec with Simulators with Checks {
     }
 
   it should "match the bipartite golden model with the output register inside the block RAM (m=3)" in {
-    bipartiteAllSplits(3, capacity = 14, counts = 2 to 14, MemoryStyle.Ecp5OutputRegister)
+    bipartiteAllSplits(3, capacity = streamCapacity(3), counts = 2 to 14, MemoryStyle.Ecp5OutputRegister)
   }
 
   behavior of "The schedule with the output register inside the block RAM (memory style ecp5-outreg)"
@@ -107,7 +110,7 @@ class ScheduleHardwareSpec extends AnyFlatSpec with Simulators with Checks {
   // m = 3 (not a power of two) for both, and stream m = 8 as FPGA-built; kept to three for make test's time.
   for ((arch, m) <- Seq(Arch.Seed -> 3, Arch.Stream -> 3, Arch.Stream -> 8))
     it should s"match the ${arch.name} golden model for m=$m and every n up to the capacity" in {
-      val capacity = if (arch == Arch.Seed) 5 * m else 5 * m + 1
+      val capacity = if (arch == Arch.Seed) 5 * m else streamCapacity(m)
       scheduleAllCounts(m, capacity => 0 to capacity, capacity, arch, MemoryStyle.Ecp5OutputRegister)
     }
 }

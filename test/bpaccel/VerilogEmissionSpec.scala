@@ -6,13 +6,14 @@ import org.scalatest.flatspec.AnyFlatSpec
 import org.scalatest.matchers.should.Matchers
 
 import scala.jdk.CollectionConverters._
+import scala.util.matching.Regex
 import scala.sys.process._
 
 /** What FPGA flows get: lint-clean SystemVerilog whose buffers are memories. */
 class VerilogEmissionSpec extends AnyFlatSpec with Matchers {
 
   private def emitted(m: Int, arch: Arch = Arch.Seed, capacity: Option[Int] = None): (AccelParams, Path) = {
-    val p   = AccelParams(m = m, capacity = capacity.getOrElse(AccelParams.defaultCapacity(m)), arch = arch)
+    val p   = AccelParams(m = m, capacity = capacity.getOrElse(arch.defaultCapacity(m)), arch = arch)
     val dir = Files.createTempDirectory(s"bpaccel-${arch.name}-m$m-")
     EmitVerilog.emit(p, dir)
     (p, dir)
@@ -99,7 +100,7 @@ class VerilogEmissionSpec extends AnyFlatSpec with Matchers {
       memories should not be empty
       for (f <- memories)
         withClue(s"$f: ") {
-          "(?m)^\\s*\\(\\* no_rw_check \\*\\) reg \\[[^\\]]+\\] Memory\\[".r.findAllIn(read(dir, f)).length shouldBe 1
+          s"(?m)^\\s*${Regex.quote(NoCollisionMemories.attribute)} reg \\[[^\\]]+\\] Memory\\[".r.findAllIn(read(dir, f)).length shouldBe 1
         }
     }
 
@@ -177,14 +178,14 @@ class VerilogEmissionSpec extends AnyFlatSpec with Matchers {
   for (m <- Seq(3, 16))
     it should s"put every lane register of the stream engine under its own lane's enable copies, m=$m" in {
       val (p, dir) = emitted(m, Arch.Stream, capacity = Some(24 * m))
-      val text     = read(dir, "StreamEngine.sv")
+      val text     = read(dir, LaneEnables.file)
       LaneEnables.mismatches(text) shouldBe empty
       LaneEnables.unguarded(text, m) shouldBe empty
       // What the miscompile looked like: lane 2's copy from the head chain under lane 1's head shift.
       val broken = text.replaceFirst("if \\(windowWrite_replica2\\)(\\s+window_2_box <=)", "if (headShift_replica1)$1")
       broken should not equal text
       LaneEnables.mismatches(broken) shouldBe Seq("window_2_box <=" -> "headShift_replica1")
-      Files.writeString(dir.resolve("StreamEngine.sv"), broken)
+      Files.writeString(dir.resolve(LaneEnables.file), broken)
       val e = the[IllegalStateException] thrownBy LaneEnables.check(p, dir)
       e.getMessage should include("assigns 'window_2_box <=' under 'headShift_replica1', another lane's enable")
       // A lane whose enables were dropped altogether.

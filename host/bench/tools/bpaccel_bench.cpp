@@ -114,6 +114,7 @@ int main(int argc, char** argv) {
 
   bpaccel::BenchConfig bench;
   bench.wholeStepObjects = 8000;
+  bench.queries.objectCounts = {8000, 100000};
   bpaccel::LineUpConfig lineUp;
   lineUp.cpuThreads = std::thread::hardware_concurrency();
   std::vector<std::string> benchCells = {"none", "16", "32", "64", "128", "256"};
@@ -177,6 +178,12 @@ int main(int argc, char** argv) {
                        "Also time full stepSimulation calls with btDbvtBroadphase and bpaccel::BulletDropIn at this "
                        "object count (0: not)")
       ->capture_default_str();
+  benchCmd->add_option("--query-objects", bench.queries.objectCounts,
+                       "Also time broad-phase rayTest and aabbTest, btDbvtBroadphase against bpaccel::BulletDropIn, "
+                       "at these object counts (none: not)")
+      ->capture_default_str();
+  benchCmd->add_option("--query-count", bench.queries.perKind, "Queries of each kind (two ray lengths, boxes) a round of the query table")
+      ->check(CLI::PositiveNumber)->capture_default_str();
   benchCmd->add_option("--cpu-threads", lineUp.cpuThreads,
                        "Threads of the extra 'cpu k-d C, T threads' rows (default: every hardware thread; 0 or 1: none)")
       ->capture_default_str();

@@ -6,7 +6,6 @@
 #include <type_traits>
 
 #include <BulletCollision/BroadphaseCollision/btOverlappingPairCache.h>
-#include <LinearMath/btAabbUtil2.h>
 #include <fmt/format.h>
 
 #include "../core/keys.hpp"
@@ -37,6 +36,14 @@ std::string describe(const btBroadphaseProxy* proxy) {
 }
 
 }  // namespace
+
+void aimRay(btBroadphaseRayCallback& callback, const RayQuery& ray) {
+  for (int a = 0; a < 3; ++a) {
+    callback.m_rayDirectionInverse[a] = ray.inverseDirection[a];
+    callback.m_signs[a] = ray.signs[a];
+  }
+  callback.m_lambda_max = ray.lambdaMax;
+}
 
 BulletDropIn::BulletDropIn(std::unique_ptr<Backend> backend, BulletDropInOptions options, btOverlappingPairCache* pairCache)
     : BulletDropIn(std::move(backend), nullptr, options, pairCache) {}
@@ -142,6 +149,7 @@ btBroadphaseProxy* BulletDropIn::createProxy(const btVector3& aabbMin, const btV
   p.live = true;
   boxes_.push_back(box);
   denseSlot_.push_back(slot);
+  queries_.set(slot, box);
   return &p;
 }
 
@@ -160,12 +168,14 @@ void BulletDropIn::destroyProxy(btBroadphaseProxy* proxy, btDispatcher* dispatch
   p.live = false;
   p.m_clientObject = nullptr;
   freeSlots_.push_back(p.slot);
+  queries_.erase(p.slot);
 }
 
 void BulletDropIn::setAabb(btBroadphaseProxy* proxy, const btVector3& aabbMin, const btVector3& aabbMax,
                          btDispatcher* /*dispatcher*/) {
   Proxy& p = owned(proxy, "setAabb");
   boxes_[p.dense] = checkedBox(aabbMin, aabbMax, &p, "setAabb");
+  queries_.set(p.slot, boxes_[p.dense]);
   p.m_aabbMin = aabbMin;
   p.m_aabbMax = aabbMax;
 }
@@ -177,22 +187,27 @@ void BulletDropIn::getAabb(btBroadphaseProxy* proxy, btVector3& aabbMin, btVecto
 }
 
 void BulletDropIn::rayTest(const btVector3& rayFrom, const btVector3& /*rayTo*/, btBroadphaseRayCallback& rayCallback,
-                         const btVector3& aabbMin, const btVector3& aabbMax) {
-  // The callback carries the ray's inverse direction, signs and length, as btDbvtBroadphase uses them.
-  const btScalar lambdaMax = rayCallback.m_lambda_max;
-  for (const auto& slot : slots_) {
-    if (!slot->live) continue;
-    const btVector3 bounds[2] = {slot->m_aabbMin - aabbMax, slot->m_aabbMax - aabbMin};
-    btScalar tmin;
-    if (btRayAabb2(rayFrom, rayCallback.m_rayDirectionInverse, rayCallback.m_signs, bounds, tmin, 0, lambdaMax))
-      rayCallback.process(slot.get());
+                           const btVector3& aabbMin, const btVector3& aabbMax) {
+  // As btDbvtBroadphase: the ray is the callback's origin, inverse direction,
+  // signs and length; rayTo is not read.
+  RayQuery ray;
+  for (int a = 0; a < 3; ++a) {
+    ray.from[a] = rayFrom[a];
+    ray.inverseDirection[a] = rayCallback.m_rayDirectionInverse[a];
+    ray.signs[a] = rayCallback.m_signs[a];
+    ray.grow.min[a] = aabbMin[a];
+    ray.grow.max[a] = aabbMax[a];
   }
+  ray.lambdaMax = rayCallback.m_lambda_max;
+  queries_.rayTest(ray, [&](std::uint32_t slot) {
+    rayCallback.process(slots_[slot].get());
+    ray.lambdaMax = rayCallback.m_lambda_max;
+  });
 }
 
 void BulletDropIn::aabbTest(const btVector3& aabbMin, const btVector3& aabbMax, btBroadphaseAabbCallback& callback) {
-  for (const auto& slot : slots_)
-    if (slot->live && TestAabbAgainstAabb2(aabbMin, aabbMax, slot->m_aabbMin, slot->m_aabbMax))
-      callback.process(slot.get());
+  const Aabb box{{aabbMin[0], aabbMin[1], aabbMin[2]}, {aabbMax[0], aabbMax[1], aabbMax[2]}};
+  queries_.aabbTest(box, [&](std::uint32_t slot) { callback.process(slots_[slot].get()); });
 }
 
 void BulletDropIn::calculateOverlappingPairs(btDispatcher* dispatcher) {
@@ -241,6 +256,7 @@ void BulletDropIn::resetPool(btDispatcher* /*dispatcher*/) {
   cacheSync_->reset();
   slots_.clear();
   freeSlots_.clear();
+  queries_.clear();
 }
 
 void BulletDropIn::printStats() {

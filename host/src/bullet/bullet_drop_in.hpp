@@ -16,10 +16,17 @@
 #include "pair_cache_sync.hpp"
 #include "../broad_phase/broad_phase.hpp"
 #include "../core/types.hpp"
+#include "../query/query_index.hpp"
 
 class btOverlappingPairCache;
 
 namespace bpaccel {
+
+/// Gives a broad-phase ray callback the ray's inverse direction, signs and
+/// length (the fields btCollisionWorld::rayTest sets for its own), for a
+/// broad-phase rayTest of any btBroadphaseInterface; with RayQuery::segment,
+/// the ray between two points.
+void aimRay(btBroadphaseRayCallback& callback, const RayQuery& ray);
 
 /// Misuse of the broad phase (bad AABB, too many proxies, a foreign or
 /// destroyed proxy); the message names the proxy and the reason.
@@ -82,10 +89,13 @@ class BulletDropIn final : public btBroadphaseInterface {
                btDispatcher* dispatcher) override;
   void getAabb(btBroadphaseProxy* proxy, btVector3& aabbMin, btVector3& aabbMax) const override;
   /// Every proxy whose AABB, grown by the ray's box (aabbMin, aabbMax), the ray
-  /// meets within the callback's m_lambda_max (btDbvtBroadphase's test).
+  /// meets within the callback's m_lambda_max (btDbvtBroadphase's test,
+  /// btRayAabb2, on the exact AABBs), read again after each process() call:
+  /// a callback may shorten the ray as it goes. Served by a tree over the
+  /// proxies (QueryIndex), rebuilt when they have changed.
   void rayTest(const btVector3& rayFrom, const btVector3& rayTo, btBroadphaseRayCallback& rayCallback,
                const btVector3& aabbMin = btVector3(0, 0, 0), const btVector3& aabbMax = btVector3(0, 0, 0)) override;
-  /// Every proxy whose AABB overlaps the box (inclusively).
+  /// Every proxy whose AABB overlaps the box (inclusively), from the same tree.
   void aabbTest(const btVector3& aabbMin, const btVector3& aabbMax, btBroadphaseAabbCallback& callback) override;
   void calculateOverlappingPairs(btDispatcher* dispatcher) override;
   btOverlappingPairCache* getOverlappingPairCache() override { return cache_; }
@@ -101,6 +111,8 @@ class BulletDropIn final : public btBroadphaseInterface {
   const BulletDropInReport& lastFrame() const { return report_; }
   /// The backend's name (cpu, model, rtl).
   const std::string& backendName() const { return backendName_; }
+  /// The index rayTest and aabbTest use (by proxy slot, m_uniqueId - 2); prepare() builds it ahead of a query.
+  QueryIndex& queryIndex() { return queries_; }
   /// Statistics of the pair finding, summed over all frames.
   const RunStats& runStats() const { return broadPhase_->stats(); }
 
@@ -127,6 +139,7 @@ class BulletDropIn final : public btBroadphaseInterface {
   std::vector<Pair> found_;                     // this frame's pairs, dense indices
   std::vector<std::uint64_t> foundKeys_;        // the same as slot keys (PairCacheSync::pairKey), sorted
   std::unique_ptr<PairCacheSync> cacheSync_;    // the cache brought to each frame's pairs
+  QueryIndex queries_;                          // the live proxies' boxes by slot, for rayTest and aabbTest
   BulletDropInReport report_;
 };
 

@@ -23,6 +23,7 @@
 #include "bpaccel_params.h"
 #include "bullet/bullet_drop_in.hpp"
 #include "device/rtl/rtl_backend.hpp"
+#include "dropping_backend.hpp"
 #include "scene.hpp"
 #include "step_timing.hpp"
 
@@ -39,22 +40,7 @@ std::unique_ptr<bpaccel::Backend> makeBackend(const std::string& name) {
   return std::make_unique<bpaccel::CpuBackend>();
 }
 
-/// A deliberately broken backend: loses every pair of the batch's first box.
-class DroppingBackend final : public bpaccel::Backend {
- public:
-  std::string name() const override { return "cpu-dropping"; }
-  std::size_t capacity() const override { return inner_.capacity(); }
-  void run(std::span<const bpaccel::KeyBox> boxes, std::vector<Pair>& out, bpaccel::RunStats& stats) override {
-    const std::size_t before = out.size();
-    inner_.run(boxes, out, stats);
-    out.erase(std::remove_if(out.begin() + static_cast<std::ptrdiff_t>(before), out.end(),
-                             [](const Pair& p) { return p.first == 0; }),
-              out.end());
-  }
-
- private:
-  bpaccel::CpuBackend inner_;
-};
+using bpaccel::testing::DroppingBackend;
 
 using Factory = bpaccel::BtBroadphaseFactory;
 Factory dbvt() {

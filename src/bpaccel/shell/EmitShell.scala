@@ -5,7 +5,7 @@ import java.nio.file.{Files, Path, Paths}
 import chisel3.stage.ChiselGeneratorAnnotation
 import circt.stage.{ChiselStage, FirtoolOption}
 
-import bpaccel.{AccelParams, Arch, CHeader, EmitVerilog, LaneEnables, MemoryStyle, NoCollisionMemories, SingleClockMemories}
+import bpaccel.{AccelParams, Arch, EmitVerilog, MemoryStyle, SingleClockMemories}
 
 /** Emits the shell of one configuration: its SystemVerilog (one file per
   * module, filelist.f), the core's bpaccel_params.h, the shell's
@@ -24,11 +24,8 @@ object EmitShell {
       Array("--target", "systemverilog", "--split-verilog", "--target-dir", targetDir.toString),
       Seq(ChiselGeneratorAnnotation(() => new BpaccelShell(p))) ++ firtoolOptions.map(FirtoolOption(_))
     )
-    SingleClockMemories.rewrite(targetDir)
-    NoCollisionMemories.rewrite(targetDir)
-    LaneEnables.check(p.core, targetDir)
+    EmitVerilog.finishCore(p.core, targetDir)
     val map = ShellRegisters(p)
-    Files.writeString(targetDir.resolve("bpaccel_params.h"), CHeader(p.core))
     Files.writeString(targetDir.resolve("bpaccel_shell.h"), ShellHeader(p))
     Files.writeString(targetDir.resolve("bpaccel_shell.rdl"), RegisterMapEmitters.systemRdl(map))
     Files.writeString(targetDir.resolve("registers.md"), RegisterMapEmitters.markdown(map, p))
@@ -59,7 +56,7 @@ object EmitShell {
   private case class Options(
     arch: String = Arch.Stream.name,
     m: Int = 8,
-    capacity: Int = 64,
+    capacity: Option[Int] = None,
     keyWidth: Int = 32,
     batchCells: Int = AccelParams().batchCells,
     memoryStyle: String = MemoryStyle.Inferred.name,
@@ -70,7 +67,7 @@ object EmitShell {
     smokeTestbench: Option[Path] = None
   ) {
     def params: ShellParams = ShellParams(
-      AccelParams(m = m, capacity = capacity, keyWidth = keyWidth, arch = Arch.fromName(arch), batchCells = batchCells,
+      AccelParams(m = m, capacity = capacity.getOrElse(Arch.fromName(arch).defaultCapacity(m)), keyWidth = keyWidth, arch = Arch.fromName(arch), batchCells = batchCells,
         memoryStyle = MemoryStyle.fromName(memoryStyle)),
       streamBits, dualClock, fifoDepth
     )
@@ -81,7 +78,7 @@ object EmitShell {
       head("Emits the bpaccel AXI shell's SystemVerilog, C headers, SystemRDL and register page")
       opt[String]("arch").action((v, o) => o.copy(arch = v)).text("core architecture: seed or stream (default stream)")
       opt[Int]("m").action((v, o) => o.copy(m = v)).text("lanes")
-      opt[Int]("capacity").action((v, o) => o.copy(capacity = v)).text("boxes per cell")
+      opt[Int]("capacity").action((v, o) => o.copy(capacity = Some(v))).text("boxes per cell (default: the architecture's)")
       opt[Int]("key-width").action((v, o) => o.copy(keyWidth = v)).text("bits per key (at most 32)")
       opt[Int]("batch-cells").action((v, o) => o.copy(batchCells = v)).text("cell counts the core queues")
       opt[String]("memory-style").action((v, o) => o.copy(memoryStyle = v)).text("inferred or ecp5-outreg")

@@ -1,0 +1,69 @@
+"""The one rule that names a configuration's folders and reports.
+
+A name is the architecture's prefix (none for the seed, whose reports keep
+their names), m, then only what differs from the defaults: the capacity when
+one is asked for, the key width when not 32, the memory style when not the
+flow's. `make` calls this (scripts/fpga/names.py) for its folders and
+results/fpga/<name>.json; sweep.py and flow.py import it.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+# The memory style `make fpga` builds unless told otherwise (make verilog's and
+# the generator's default too); reports of another carry it as a suffix.
+FLOW_MEMORY_STYLE = "inferred"
+DEFAULT_KEY_WIDTH = 32
+
+
+def prefix(arch: str) -> str:
+    return "" if arch == "seed" else f"{arch}-"
+
+
+def key_suffix(key_width: int) -> str:
+    return "" if key_width == DEFAULT_KEY_WIDTH else f"-k{key_width}"
+
+
+def design_name(arch: str, m: int, key_width: int = DEFAULT_KEY_WIDTH, capacity: int | None = None,
+                memory_style: str | None = None) -> str:
+    """stream-m8, m8 (seed), stream-m64-c4096-k16, stream-m8-ecp5-outreg, ..."""
+    name = f"{prefix(arch)}m{m}"
+    if capacity is not None:
+        name += f"-c{capacity}"
+    name += key_suffix(key_width)
+    if memory_style and memory_style != FLOW_MEMORY_STYLE:
+        name += f"-{memory_style}"
+    return name
+
+
+def params_name(params: dict) -> str:
+    """The name of the design a bpaccel_params.json describes (its capacity named only when not the default)."""
+    capacity = params["capacity"] if params["capacity"] != params["default_capacity"] else None
+    return design_name(params["arch"], params["m"], params["key_width"], capacity, params["memory_style"])
+
+
+def sweep_file(arch: str, key_width: int) -> str:
+    return f"{prefix(arch)}sweep{key_suffix(key_width)}.json"
+
+
+def main(argv: list[str] | None = None) -> int:
+    import argparse
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--params", type=Path, help="name the design this bpaccel_params.json describes")
+    ap.add_argument("--arch")
+    ap.add_argument("--m", type=int)
+    ap.add_argument("--key-width", type=int, default=DEFAULT_KEY_WIDTH)
+    ap.add_argument("--capacity", type=int)
+    ap.add_argument("--memory-style")
+    ap.add_argument("--key-suffix", action="store_true", help="print only the key width's suffix")
+    args = ap.parse_args(argv)
+    if args.key_suffix:
+        print(key_suffix(args.key_width))
+    elif args.params:
+        print(params_name(json.loads(args.params.read_text())))
+    elif args.arch and args.m:
+        print(design_name(args.arch, args.m, args.key_width, args.capacity, args.memory_style))
+    else:
+        ap.error("give --params, or --arch and --m")
+    return 0
