@@ -33,8 +33,14 @@ VERILOG_DIR ?= generated/$(shell $(NAMES) $(if $(MEMORY_STYLE),--memory-style $(
 
 # The host is built for one configuration: ARCH, M, CAPACITY and KEY_WIDTH
 # above (a device with narrower keys gets each cell's keys narrowed and the
-# host checks its pairs with the full keys; docs/host.md).
-HOST_VERILOG := build/verilog/$(DESIGN_NAME)
+# host checks its pairs with the full keys; docs/host.md). It verilates the
+# AXI shell around that core (docs/integration.md): the shell's Verilog,
+# bpaccel_params.h and bpaccel_shell.h come from one emission. Its streams
+# carry a box a beat or more (256 bits for keys above 16 bits, 128 below),
+# so the core takes a box a cycle and its cycles are the model's.
+HOST_STREAM_BITS ?= $(shell [ $(KEY_WIDTH) -le 16 ] && echo 128 || echo 256)
+HOST_DUAL_CLOCK  ?= true
+HOST_VERILOG := build/host-shell/$(DESIGN_NAME)-w$(HOST_STREAM_BITS)$(if $(filter true,$(HOST_DUAL_CLOCK)),,-1clk)
 HOST_BUILD   := build/host-$(DESIGN_NAME)
 # Where the bpaccel CLI goes; the benchmark's configuration gets its own.
 # A device of narrower keys gets its own too (build/bin-k16).
@@ -73,11 +79,11 @@ test-hw: deps
 # The formal checks at depths that cover a whole run of each small
 # configuration (docs/verification.md); `make test` runs shallower ones.
 formal-long: deps
-	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec bpaccel.FormalMutantSpec"
+	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec bpaccel.FormalMutantSpec bpaccel.binning.BinningFormalSpec"
 
-# The C++ host (build/bin/bpaccel, build/bin/bpaccel-bench) with the Verilated accelerator, and its tests.
-EMIT_HOST = "runMain bpaccel.EmitVerilog $(EMIT_ARGS) --target-dir $(HOST_VERILOG)"
-$(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) | deps
+# The C++ host (build/bin/bpaccel, build/bin/bpaccel-bench) with the Verilated shell and core, and its tests.
+EMIT_HOST = "runMain bpaccel.shell.EmitShell $(EMIT_ARGS) --stream-bits $(HOST_STREAM_BITS) --dual-clock $(HOST_DUAL_CLOCK) --target-dir $(HOST_VERILOG)"
+$(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) $(wildcard src/bpaccel/shell/*.scala) | deps
 	$(SBT) $(EMIT_HOST)
 
 host: deps $(HOST_VERILOG)/filelist.f

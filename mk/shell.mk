@@ -23,7 +23,7 @@ shell-verilog: deps
 
 # docs/registers.md, from the default configuration's register map.
 shell-registers: deps
-	$(SBT) "runMain bpaccel.shell.EmitShell --target-dir build/shell/registers"
+	$(SBT) "runMain bpaccel.shell.EmitShell --capacity 64 --target-dir build/shell/registers"
 	cp build/shell/registers/registers.md docs/registers.md
 
 # The shell's own tests (also part of `make test` through test-hw): lint, no

@@ -1,8 +1,6 @@
 package bpaccel
 
-import java.nio.file.{Files, Path}
-
-import scala.util.matching.Regex
+import java.nio.file.Path
 
 /** Tells synthesis that no memory is read and written at the same row in the
   * same cycle, so it need not build the collision behaviour.
@@ -29,21 +27,10 @@ import scala.util.matching.Regex
 object NoCollisionMemories {
   val attribute = """(* ramstyle = "no_rw_check", syn_ramstyle = "no_rw_check", rw_addr_collision = "no" *)"""
 
-  /** The one array declaration of a firtool memory module: `reg [w:0] Memory[0:d];`. */
-  private val ArrayDeclaration = """(?m)^(\s*)(reg\s+\[[^\]]+\]\s+Memory\s*\[[^\]]+\]\s*;)""".r
-
   /** Marks the array of every memory module `mem_*.sv` that `dir/filelist.f` lists; returns their files. */
   def rewrite(dir: Path): Seq[String] = {
     val memories = SingleClockMemories.memoryFiles(dir)
-    for (path <- memories) {
-      val file = path.getFileName.toString
-      val text = Files.readString(path)
-      val declarations = ArrayDeclaration.findAllMatchIn(text).length
-      if (declarations != 1)
-        throw new IllegalStateException(s"NoCollisionMemories: $file: expected one 'reg [..] Memory[..];', found $declarations")
-      if (!text.contains(attribute))
-        Files.writeString(path, ArrayDeclaration.replaceAllIn(text, m => Regex.quoteReplacement(s"${m.group(1)}$attribute ${m.group(2)}")))
-    }
+    memories.foreach(MemoryAttributes.mark(_, attribute, "NoCollisionMemories"))
     memories.map(_.getFileName.toString)
   }
 }

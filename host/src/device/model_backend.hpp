@@ -11,9 +11,9 @@
 namespace bpaccel {
 
 /// Fast C++ model of the accelerator: the same schedule, pairs and cycle
-/// counts (loads included) as the RTL driven by a host that loads one box a
-/// cycle and a consumer that never stalls, for any n up to its capacity and
-/// at software speed. Both architectures share the schedule and differ only
+/// counts (loads included) as the RTL behind its shell (CELLS commands, which
+/// feed the core's batch port a box a cycle) with a consumer that never
+/// stalls, for any n up to its capacity and at software speed. Both architectures share the schedule and differ only
 /// in the cycles before the first issue (DeviceParams::startupCycles).
 /// Batches of up to batchCells cells cost what the hardware's front end adds:
 /// one cycle per batch and one per cell; with batchOverlapsLoads each cell
@@ -37,7 +37,7 @@ class ModelBackend final : public Backend {
   /// One cell's pairs and counters (split 0: all pairs), without counting it
   /// as a run; its load cycles and cycles depend on the hand-over (run, or batchCycles).
   void runCell(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats) const;
-  /// One cell as its own run and hand-over: runCell plus its loads and busy cycles.
+  /// One cell as its own run and hand-over: runCell plus the cycles of a batch of that one cell.
   void runSplit(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats) override;
   /// All busy cycles of a run of n objects.
   std::uint64_t busyCycles(std::uint64_t n, std::uint64_t split = 0) const;

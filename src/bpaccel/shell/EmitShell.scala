@@ -56,7 +56,7 @@ object EmitShell {
   private case class Options(
     arch: String = Arch.Stream.name,
     m: Int = 8,
-    capacity: Int = 64,
+    capacity: Option[Int] = None,
     keyWidth: Int = 32,
     batchCells: Int = AccelParams().batchCells,
     memoryStyle: String = MemoryStyle.Inferred.name,
@@ -67,7 +67,7 @@ object EmitShell {
     smokeTestbench: Option[Path] = None
   ) {
     def params: ShellParams = ShellParams(
-      AccelParams(m = m, capacity = capacity, keyWidth = keyWidth, arch = Arch.fromName(arch), batchCells = batchCells,
+      AccelParams(m = m, capacity = capacity.getOrElse(Arch.fromName(arch).defaultCapacity(m)), keyWidth = keyWidth, arch = Arch.fromName(arch), batchCells = batchCells,
         memoryStyle = MemoryStyle.fromName(memoryStyle)),
       streamBits, dualClock, fifoDepth
     )
@@ -78,7 +78,7 @@ object EmitShell {
       head("Emits the bpaccel AXI shell's SystemVerilog, C headers, SystemRDL and register page")
       opt[String]("arch").action((v, o) => o.copy(arch = v)).text("core architecture: seed or stream (default stream)")
       opt[Int]("m").action((v, o) => o.copy(m = v)).text("lanes")
-      opt[Int]("capacity").action((v, o) => o.copy(capacity = v)).text("boxes per cell")
+      opt[Int]("capacity").action((v, o) => o.copy(capacity = Some(v))).text("boxes per cell (default: the architecture's)")
       opt[Int]("key-width").action((v, o) => o.copy(keyWidth = v)).text("bits per key (at most 32)")
       opt[Int]("batch-cells").action((v, o) => o.copy(batchCells = v)).text("cell counts the core queues")
       opt[String]("memory-style").action((v, o) => o.copy(memoryStyle = v)).text("inferred or ecp5-outreg")

@@ -1,47 +1,57 @@
 #pragma once
-// The Verilated accelerator as a Backend.
+// The Verilated device as a Backend: the shell around the core, driven by
+// the shell's driver over the Verilated transport.
 
 #include <cstdint>
 #include <functional>
 #include <memory>
-#include <optional>
 
 #include "../backend.hpp"
 #include "../built_device.hpp"
-
-class VBroadPhaseAccel;
-class VerilatedContext;
+#include "shell/shell_driver.hpp"
+#include "verilated_shell_transport.hpp"
 
 namespace bpaccel {
 
-/// Drives the generated hardware cycle by cycle through its load port, start
-/// command and result port, and reports the hardware's own counters. The
-/// configuration comes from bpaccel_params.h, and the constructor checks it
-/// against the model's info port.
+struct RtlBackendConfig {
+  VerilatedShellConfig shell;   // clocks, and the streams' ready patterns
+  ShellDriverConfig driver;     // interrupts or polling, timeouts
+};
+
+/// Runs cells on the Verilated shell (BpaccelShell with its core) through
+/// ShellDriver: each hand-over is CELLS commands of at most batchCells()
+/// cells, a real driver's register sequence and interrupt handling, and the
+/// counters are each reply's trailer. The configuration comes from
+/// bpaccel_params.h and bpaccel_shell.h, which the driver's probe checks
+/// against the model's registers.
 class RtlBackend final : public Backend {
  public:
-  /// `consumerReady(cycle)` is the result consumer's ready pattern; by default
-  /// it is always ready, like a host that drains a FIFO at full rate.
-  explicit RtlBackend(std::function<bool(std::uint64_t)> consumerReady = {});
+  /// `replyReady(cycle)` is the reply channel's TREADY pattern; by default it
+  /// is always ready, like a DMA engine with buffers posted.
+  explicit RtlBackend(std::function<bool(std::uint64_t)> replyReady = {});
+  explicit RtlBackend(RtlBackendConfig config);
   ~RtlBackend() override;
   RtlBackend(const RtlBackend&) = delete;
   RtlBackend& operator=(const RtlBackend&) = delete;
 
   std::string name() const override { return "rtl"; }
   std::size_t capacity() const override;
-  /// On any failure (a hang, a hardware error) the device is reset before the
-  /// exception leaves, so the next run starts from an idle accelerator.
+  /// One cell: a CELLS command of one cell (the shell has no other start).
   void run(std::span<const KeyBox> boxes, std::vector<Pair>& out, RunStats& stats) override;
-  /// Pushes the cells' counts (and splits) on the batch port and streams
-  /// their boxes, one a cycle, as hardware batches of at most batchCells()
-  /// cells each. On any failure the device is reset and nothing of the call
-  /// is left in `out`, `cellEnds` or `stats`.
+  /// CELLS commands of at most batchCells() cells each, one after the other.
+  /// Bad input throws before anything reaches the device; on any failure
+  /// nothing of the call is left in `out`, `cellEnds` or `stats`, and the
+  /// device is ready for the next call (the driver aborts or resets it).
   using Backend::runBatch;
   void runBatch(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
                 std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats) override;
   /// BPACCEL_BIPARTITE_RUNS: the stream architecture's hardware.
   bool bipartite() const override;
   unsigned keyWidth() const override;
+
+  /// The driver and the transport, for tests of the shell.
+  ShellDriver& driver() { return *driver_; }
+  VerilatedShellTransport& transport() { return *transport_; }
 
   static std::size_t lanes();
   static std::size_t batchCells();
@@ -50,19 +60,14 @@ class RtlBackend final : public Backend {
   static std::uint64_t runOverheadCycles();
 
  private:
-  void settle();  // evaluate combinational outputs for the current inputs
-  void tick();    // one rising clock edge
-  void reset();
-  /// One start with the split (0: all pairs); on any failure the device is
-  /// reset before the exception leaves, as in run().
   void runSplit(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats) override;
-  void runOnHardware(std::span<const KeyBox> boxes, std::size_t split, std::vector<Pair>& out, RunStats& stats);
-  void batchOnHardware(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits,
-                       std::vector<Pair>& out, std::vector<std::size_t>& cellEnds, RunStats& stats);
+  /// Throws, before the device sees anything, for cells it would refuse.
+  void checkCells(std::span<const std::span<const KeyBox>> cells, std::span<const std::size_t> splits) const;
+  void runCommands(const CellsCommand& all, std::vector<Pair>& out, std::vector<std::size_t>& cellEnds,
+                   RunStats& stats);
 
-  std::unique_ptr<VerilatedContext> context_;
-  std::unique_ptr<VBroadPhaseAccel> top_;
-  std::function<bool(std::uint64_t)> consumerReady_;
+  std::unique_ptr<VerilatedShellTransport> transport_;
+  std::unique_ptr<ShellDriver> driver_;
 };
 
 /// The backend `name` ("rtl", "model" or "cpu") of the hardware this host was

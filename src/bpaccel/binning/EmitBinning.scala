@@ -1,0 +1,73 @@
+package bpaccel.binning
+
+import java.nio.file.{Files, Path, Paths}
+
+import chisel3.stage.ChiselGeneratorAnnotation
+import circt.stage.{ChiselStage, FirtoolOption}
+
+import bpaccel.{DistributedMemories, EmitVerilog, MemoryStyle, NoCollisionMemories, SingleClockMemories}
+
+/** Emits one binning configuration: SystemVerilog (one file per module and
+  * filelist.f), its C header and its JSON parameter file.
+  *
+  * ./scripts/sbt "runMain bpaccel.binning.EmitBinning --target-dir generated/binning"
+  */
+object EmitBinning {
+  val headerFile = "bpaccel_binning_params.h"
+  val jsonFile   = "bpaccel_params.json"
+
+  def emit(p: BinningParams, targetDir: Path): Path = {
+    Files.createDirectories(targetDir)
+    (new ChiselStage).execute(
+      Array("--target", "systemverilog", "--split-verilog", "--target-dir", targetDir.toString),
+      Seq(ChiselGeneratorAnnotation(() => new BinningCore(p))) ++ EmitVerilog.firtoolOptions.map(FirtoolOption(_))
+    )
+    SingleClockMemories.rewrite(targetDir)
+    NoCollisionMemories.rewrite(targetDir)
+    // The table's module must not be an entry or order memory's too (same rows and width), or those would go to LUT RAM.
+    val table = CellTable.memoryModule(p)
+    if (Seq(p.entryBits, p.entryAddrWidth).map(w => s"mem_${p.groupCapacity}x$w").contains(table))
+      throw new IllegalArgumentException(s"EmitBinning: the cell table's memory module $table is also a group memory's; " +
+        "change groupCapacity or cellBits")
+    DistributedMemories.rewrite(targetDir, Seq(table))
+    Files.writeString(targetDir.resolve(headerFile), BinningHeader.cHeader(p))
+    Files.writeString(targetDir.resolve(jsonFile), BinningHeader.json(p))
+    Files.writeString(targetDir.resolve(EmitVerilog.lintWaivers), lintWaiverText)
+    targetDir.resolve("filelist.f")
+  }
+
+  /** chisel3.util.Queue's memory reads combinationally: firtool's ram module has a read clock it never uses. */
+  private val lintWaiverText =
+    "`verilator_config\n" +
+      "lint_off -rule UNUSEDSIGNAL -file \"*ram_*.sv\" -match \"*R0_clk*\"\n"
+
+  private case class Options(p: BinningParams = BinningParams(), targetDir: Path = Paths.get("generated/binning"))
+
+  def main(args: Array[String]): Unit = {
+    val d = BinningParams()
+    val parser = new scopt.OptionParser[Options]("EmitBinning") {
+      head("Emits the binning device's SystemVerilog, C header and JSON parameters")
+      opt[String]("group-bits").action((v, o) => o.copy(p = o.p.copy(groupBits = v.split("[x,]").map(_.toInt).toSeq)))
+        .text(s"ax,ay,az: 2^a groups per axis (default ${d.groupBits.mkString(",")})")
+      opt[Int]("lanes-per-group").action((v, o) => o.copy(p = o.p.copy(lanesPerGroup = v))).text(s"g (default ${d.g})")
+      opt[Int]("key-width").action((v, o) => o.copy(p = o.p.copy(keyWidth = v))).text(s"default ${d.keyWidth}")
+      opt[Int]("cell-bits").action((v, o) => o.copy(p = o.p.copy(cellBits = v))).text(s"default ${d.cellBits}")
+      opt[Int]("box-capacity").action((v, o) => o.copy(p = o.p.copy(boxCapacity = v))).text(s"default ${d.boxCapacity}")
+      opt[Int]("group-capacity").action((v, o) => o.copy(p = o.p.copy(groupCapacity = v))).text(s"default ${d.groupCapacity}")
+      opt[Int]("intake-boxes").action((v, o) => o.copy(p = o.p.copy(intakeBoxes = v))).text(s"default ${d.intakeBoxes}")
+      opt[Int]("pairs-per-beat").action((v, o) => o.copy(p = o.p.copy(pairsPerBeat = v))).text(s"default ${d.pairsPerBeat}")
+      opt[Int]("memory-output-stages").action((v, o) => o.copy(p = o.p.copy(memoryOutputStages = v)))
+        .text(s"default ${d.memoryOutputStages}")
+      opt[String]("memory-style").action((v, o) => o.copy(p = o.p.copy(memoryStyle = MemoryStyle.fromName(v))))
+        .text(s"${MemoryStyle.all.map(_.name).mkString(" or ")} (default ${d.memoryStyle.name})")
+      opt[Boolean]("debug-port").action((v, o) => o.copy(p = o.p.copy(debugPort = v)))
+      opt[String]("target-dir").action((v, o) => o.copy(targetDir = Paths.get(v))).text("output folder")
+    }
+    parser.parse(args, Options()) match {
+      case Some(o) =>
+        val out = emit(o.p, o.targetDir)
+        println(s"wrote $out, $headerFile and $jsonFile for ${o.p}")
+      case None => sys.exit(2)
+    }
+  }
+}

@@ -1,0 +1,102 @@
+package bpaccel.binning
+
+import java.nio.file.{Files, Path}
+
+import scala.jdk.CollectionConverters._
+import scala.sys.process._
+
+import org.scalatest.flatspec.AnyFlatSpec
+import org.scalatest.matchers.should.Matchers
+
+import bpaccel.{DistributedMemories, EmitVerilog, NoCollisionMemories, SingleClockMemories}
+
+/** What FPGA flows and hosts get from EmitBinning: lint-clean SystemVerilog,
+  * memories that synthesis maps to block RAM, and a C header and JSON file
+  * that say the same as the parameters.
+  */
+class BinningEmissionSpec extends AnyFlatSpec with Matchers {
+  private lazy val default = emitted(BinningParams())
+
+  private def emitted(p: BinningParams): (BinningParams, Path) = {
+    val dir = Files.createTempDirectory("bpaccel-binning-")
+    EmitBinning.emit(p, dir)
+    (p, dir)
+  }
+  private def read(dir: Path, file: String): String = Files.readString(dir.resolve(file))
+  private def run(dir: Path, cmd: Seq[String]): (Int, String) = {
+    val log = new StringBuilder
+    val exit = Process(cmd, dir.toFile).!(ProcessLogger(l => log.append(l).append('\n'), l => log.append(l).append('\n')))
+    (exit, log.toString)
+  }
+
+  behavior of "EmitBinning"
+
+  it should "emit SystemVerilog that verilator --lint-only -Wall passes without a warning (the defaults)" in {
+    val (_, dir) = default
+    val (exit, log) = run(dir, Seq("verilator", "--lint-only", "-Wall", EmitVerilog.lintWaivers, "-F", "filelist.f",
+      "--top-module", "BinningCore"))
+    withClue(log.take(4000)) { exit shouldBe 0; log.trim shouldBe empty }
+  }
+
+  it should "give each group an entry memory, an order memory and a cell table, one clock each and no collision bypass" in {
+    val (p, dir) = default
+    val memories = SingleClockMemories.memoryFiles(dir).map(_.getFileName.toString).sorted
+    memories shouldBe Seq(s"mem_${p.groupCapacity}x${p.entryAddrWidth}.sv", s"mem_${p.groupCapacity}x${p.entryBits}.sv",
+      s"mem_${p.localCells}x${p.entryCountWidth}.sv").sorted
+    for (m <- memories) withClue(s"$m: ") {
+      read(dir, m) should include(NoCollisionMemories.attribute)
+      read(dir, m) should not include "R0_clk"
+      // Only the cell table asks for LUT RAM.
+      (read(dir, m).contains(DistributedMemories.attribute)) shouldBe (m == s"${CellTable.memoryModule(p)}.sv")
+    }
+    // Each group instantiates the three; there are G groups.
+    "(?m)^\\s*LaneGroup\\s+\\w+\\s*\\(".r.findAllIn(read(dir, "BinningCore.sv")).length shouldBe p.groups
+  }
+
+  it should "map the entry and order memories alone to ECP5 block RAM (DP16KD) and the cell table to LUT RAM" in {
+    val (p, dir) = default
+    def cells(module: String, file: String): Map[String, Int] = {
+      val (exit, log) = run(dir, Seq("yosys", "-q", "-p", s"read_verilog -sv $file; synth_ecp5 -top $module; tee -o $file.stat stat"))
+      withClue(log.takeRight(3000)) { exit shouldBe 0 }
+      "(?m)^\\s+(\\w+)\\s+(\\d+)$".r.findAllMatchIn(read(dir, s"$file.stat")).map(x => x.group(1) -> x.group(2).toInt).toMap
+    }
+    def memory(module: String): Map[String, Int] = cells(module, s"$module.sv")
+    val entries = memory(s"mem_${p.groupCapacity}x${p.entryBits}")
+    entries.getOrElse("DP16KD", 0) shouldBe 4 // 1024 x 71: four 1024 x 18 blocks
+    entries.keys.filter(_.startsWith("TRELLIS_DPR")) shouldBe empty
+    memory(s"mem_${p.groupCapacity}x${p.entryAddrWidth}").getOrElse("DP16KD", 0) shouldBe 1
+    val tableModule = CellTable.memoryModule(p)
+    val table = memory(tableModule)
+    table.getOrElse("DP16KD", 0) shouldBe 0
+    table.getOrElse("TRELLIS_DPR16X4", 0) shouldBe 24 // 128 x 11: 8 x 3 blocks of 16 x 4
+    // The attribute does it: without it, Yosys puts the table into a DP16KD of its own.
+    Files.writeString(dir.resolve("bare-table.sv"), read(dir, s"$tableModule.sv").replace(s"${DistributedMemories.attribute} ", ""))
+    cells(tableModule, "bare-table.sv").getOrElse("DP16KD", 0) shouldBe 1
+  }
+
+  it should "write a C header and a JSON file with the parameters and every error code" in {
+    val (p, dir) = default
+    val header = read(dir, EmitBinning.headerFile)
+    val json   = read(dir, EmitBinning.jsonFile)
+    header should include(s"#define BPACCEL_BIN_GROUPS ${p.groups}\n")
+    header should include(s"#define BPACCEL_BIN_LANES ${p.lanes}\n")
+    header should include(s"#define BPACCEL_BIN_FINGERPRINT \"${p.fingerprint}\"\n")
+    json should include(s"\"lanes_per_group\": ${p.g},")
+    json should include(s"\"box_capacity\": ${p.boxCapacity},")
+    for ((name, code) <- BinningErrorCode.names) {
+      header should include(s"#define BPACCEL_BIN_ERROR_$name $code\n")
+      json should include(s"\"error_${name.toLowerCase}\": $code")
+    }
+    // The JSON parses as flat "key": value lines.
+    json.trim.linesIterator.toSeq.drop(1).dropRight(1).foreach(_ should fullyMatch regex "\\s+\"[a-z0-9_]+\": (-?\\d+|\"[^\"]*\"),?")
+  }
+
+  it should "refuse parameters that break the design's assumptions, naming them" in {
+    the[IllegalArgumentException] thrownBy BinningParams(groupBits = Seq(0, 1, 1)) should have message
+      "requirement failed: each of groupBits must lie in 1..cellBits = 4 (two neighbouring cells need different groups), got 0, 1, 1"
+    an[IllegalArgumentException] should be thrownBy BinningParams(keyWidth = 4) // no bit left for the offset
+    an[IllegalArgumentException] should be thrownBy BinningParams(pairsPerBeat = 33) // more lanes than groups
+    an[IllegalArgumentException] should be thrownBy BinningParams(memoryOutputStages = 0,
+      memoryStyle = bpaccel.MemoryStyle.Ecp5OutputRegister)
+  }
+}
