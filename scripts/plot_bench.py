@@ -19,30 +19,49 @@ def ran(m):
     return "skipped" not in m and m.get("frame_ms") is not None
 
 
+def profile_of(m):
+    """The device profile an accelerator row is modelled on ("" for none)."""
+    return (m.get("profile") or {}).get("name", "")
+
+
+def platforms(cfg):
+    """Each platform the accelerator rows are modelled on, for titles: its name, part and clock."""
+    profiles = cfg.get("profiles") or []
+    if not profiles:
+        return f"{cfg.get('clock_hz', 0) / 1e6:.0f} MHz"
+    return "\n".join(f"{p['name']}: {p['part']['name']} {p['part']['clock_hz']['value'] / 1e6:.0f} MHz "
+                     f"({p['part']['clock_hz']['provenance']}), {p['link']['generation']} "
+                     f"{p['link']['effective_bytes_per_second_each_way']['value'] / 1e9:.2f} GB/s "
+                     f"({p['link']['effective_bytes_per_second_each_way']['provenance']})" for p in profiles)
+
+
 def plot_acceleration(rows, cfg, out):
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = plt.subplots(figsize=(7, 5))
     counts = [r["objects"] for r in rows]
-    for kind, style in (("accelerator", "-o"), ("cpu", "--s")):
+    series = [("cpu", "", "--s")] + [("accelerator", p, "-o") for p in
+                                      sorted({profile_of(m) for r in rows for m in r["methods"]
+                                              if m["kind"] == "accelerator"})]
+    for kind, profile, style in series:
         for cell in cfg["cell_sizes"]:
             xs, ys = [], []
             for r in rows:
                 base = r.get("fastest_baseline")
                 m = next((m for m in r["methods"] if m["kind"] == kind and str(m["cell_size"]) == cell
-                          and m.get("partition", "k-d") == "k-d"), None)
+                          and m.get("partition", "k-d") == "k-d" and profile_of(m) == profile), None)
                 if base and m and ran(m):
                     xs.append(r["objects"])
                     ys.append(base["frame_ms"] / m["frame_ms"]["median"])
             if xs:
-                ax.plot(xs, ys, style, label=f"{kind}, cell {cell}", alpha=1.0 if kind == "accelerator" else 0.5)
+                label = f"{kind} on {profile}, cell {cell}" if profile else f"{kind}, cell {cell}"
+                ax.plot(xs, ys, style, label=label, alpha=1.0 if kind == "accelerator" else 0.5)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.axhline(1, color="grey", lw=0.8)
     ax.set_xlabel("objects")
     ax.set_ylabel("acceleration over the fastest baseline")
     names = ", ".join(f"n={r['objects']}: {r['fastest_baseline']['name']}" for r in rows if r.get("fastest_baseline"))
-    clock = cfg.get("clock_hz", 0) / 1e6
-    ax.set_title(f"m={cfg.get('hardware', {}).get('m', '?')}, {clock:.0f} MHz (device and link modelled, host "
-                 f"measured)\nfastest of Bullet and the peers: {names}", fontsize=7)
+    ax.set_title(f"m={cfg.get('hardware', {}).get('m', '?')}, device and link modelled, host measured\n"
+                 f"{platforms(cfg)}\nfastest of Bullet and the peers: {names}", fontsize=6)
     ax.set_xticks(counts)
     ax.set_xticklabels([str(c) for c in counts])
     ax.legend(fontsize=7, ncol=2)
@@ -56,7 +75,8 @@ def plot_methods(rows, out):
     names = []
     for r in rows:
         for m in r["methods"]:
-            if m["name"] not in names and (m["kind"] in ("bullet", "peer") or m["name"].endswith(" 128")):
+            if m["name"] not in names and (m["kind"] in ("bullet", "peer") or m["name"].endswith(" 128")
+                                           or " 128 on " in m["name"]):
                 names.append(m["name"])
     for name in names:
         xs, ys = [], []
@@ -84,7 +104,8 @@ def plot_parts(rows, out):
     fig, axes = plt.subplots(1, len(rows), figsize=(4 * len(rows), 4), squeeze=False)
     for ax, r in zip(axes[0], rows):
         accel = [m for m in r["methods"] if m["kind"] == "accelerator" and ran(m)]
-        names = [f'{m.get("partition", "k-d")} {m["cell_size"]}' for m in accel]
+        names = [f'{m.get("partition", "k-d")} {m["cell_size"]}' + (f' on {profile_of(m)}' if profile_of(m) else "")
+                 for m in accel]
         host = [m["host_ms_measured"]["median"] for m in accel]
         dev = [m["device_ms_modelled"]["median"] for m in accel]
         xfer = [m["transfer_ms_modelled"]["median"] for m in accel]
@@ -92,7 +113,7 @@ def plot_parts(rows, out):
         ax.bar(names, dev, bottom=host, label="device, loads included (modelled)")
         ax.bar(names, xfer, bottom=[h + d for h, d in zip(host, dev)], label="transfer (modelled)")
         ax.set_title(f"n = {r['objects']}")
-        ax.set_xlabel("partition and cell size")
+        ax.set_xlabel("partition, cell size and device profile")
         ax.tick_params(axis="x", labelrotation=45)
         ax.set_ylabel("ms per frame (median)")
     axes[0][0].legend(fontsize=7)

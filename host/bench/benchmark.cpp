@@ -100,10 +100,13 @@ std::vector<MethodSpec> standardLineUp(const LineUpConfig& config) {
   for (auto&& group : {fclMethods(config.maxSweepTests), cgalMethods(), odeMethods(config.maxSweepTests)})
     for (auto& s : group) specs.push_back(s);
   const std::vector<std::optional<std::size_t>> gridCells(config.gridCellSizes.begin(), config.gridCellSizes.end());
-  if (config.device) {
-    for (auto& s : acceleratorMethods(config.device, config.cellSizes, config.maxAllPairsTests))
-      specs.push_back(std::move(s));
-    for (auto& s : acceleratorMethods(config.device, gridCells, config.maxAllPairsTests, PartitionKind::UniformGrid))
+  std::vector<std::shared_ptr<const DeviceConfig>> devices;
+  if (config.device && config.profiles.empty()) devices.push_back(config.device);
+  for (const auto& p : config.profiles)
+    if (config.device) devices.push_back(std::make_shared<const DeviceConfig>(withProfile(*config.device, p)));
+  for (const auto& device : devices) {
+    for (auto& s : acceleratorMethods(device, config.cellSizes, config.maxAllPairsTests)) specs.push_back(std::move(s));
+    for (auto& s : acceleratorMethods(device, gridCells, config.maxAllPairsTests, PartitionKind::UniformGrid))
       specs.push_back(std::move(s));
   }
   for (auto& s : cpuMethods(config.cellSizes, config.maxAllPairsTests)) specs.push_back(std::move(s));
@@ -123,17 +126,22 @@ nlohmann::json describe(const LineUpConfig& config) {
   if (const auto& d = config.device) {
     j["accelerator_backend"] = d->backend;
     j["hardware"] = d->hardware;
-    j["clock_hz"] = d->clockHz;
-    j["clock_source"] = d->clockSource;
-    j["link_model"] = {{"bandwidth_bytes_per_second", d->link.bandwidthBytesPerSecond},
-                       {"latency_seconds_per_run", d->link.latencySeconds},
-                       {"cells_per_batch", d->cellsPerBatch},
+    j["link_model"] = {{"cells_per_batch", d->cellsPerBatch},
                        {"first_batch_cells", d->firstBatchCells ? std::min(d->firstBatchCells, d->cellsPerBatch)
                                                                 : d->cellsPerBatch},
                        {"bytes_per_box", d->link.bytesPerBox},
                        {"bytes_per_result_beat", d->link.bytesPerBeat},
                        {"formula", "transfer = batches * latency + max(0, box bytes / bandwidth - load cycles / clock) "
                                    "+ result bytes / bandwidth; device = (load + compute + drain cycles) / clock"}};
+    if (config.profiles.empty()) {
+      // One platform, the device's own: its clock and link at the top, as they are not a profile's.
+      j["clock_hz"] = d->clockHz;
+      j["clock_source"] = d->clockSource;
+      j["link_model"]["bandwidth_bytes_per_second"] = d->link.bandwidthBytesPerSecond;
+      j["link_model"]["latency_seconds_per_run"] = d->link.latencySeconds;
+    }
+    j["profiles"] = nlohmann::json::array();
+    for (const auto& p : config.profiles) j["profiles"].push_back(p.toJson());
   }
   return j;
 }
@@ -452,6 +460,7 @@ nlohmann::json Benchmark::runRow(SceneFamily family, std::size_t objects) {
                      : e.spec->cellSize ? nlohmann::json(*e.spec->cellSize)
                                         : nlohmann::json("none");
     if (!e.spec->partition.empty()) j["partition"] = e.spec->partition;
+    if (!e.spec->profile.is_null()) j["profile"] = e.spec->profile;
     if (e.skipped) {
       j["skipped"] = *e.skipped;
       j["frame_ms"] = nullptr;
@@ -543,7 +552,7 @@ std::string Benchmark::table(const nlohmann::json& results) {
     return t;
   }
   const auto& cfg = results["configuration"];
-  constexpr std::size_t kName = 32;
+  constexpr std::size_t kName = 34;  // "accelerator grid 128 on ecp5-5g"
   std::vector<std::string> names;  // every method of any row, in line-up order
   for (const auto& r : rows)
     for (const auto& m : r["methods"])
@@ -576,7 +585,7 @@ std::string Benchmark::table(const nlohmann::json& results) {
   };
 
   std::string legend = "accelerator = measured host + modelled device + modelled transfer";
-  if (cfg.contains("clock_hz")) {
+  if (cfg.contains("link_model")) {
     const auto perBatch = cfg["link_model"].value("cells_per_batch", std::size_t{1});
     const auto first = cfg["link_model"].value("first_batch_cells", perBatch);
     const std::string handOvers =
@@ -586,14 +595,21 @@ std::string Benchmark::table(const nlohmann::json& results) {
     // A device of narrower keys gets them narrowed per cell, its pairs checked on the host (docs/host.md).
     const auto keyWidth = cfg.contains("hardware") ? cfg["hardware"].value("key_width", 32) : 32;
     const std::string keys = keyWidth == 32 ? "" : fmt::format(", {}-bit keys narrowed per cell", keyWidth);
+    // Each platform: the device's own clock and link, or each profile's, named.
+    std::string platforms;
+    if (cfg.contains("clock_hz"))
+      platforms = fmt::format("{:.1f} MHz; link {:.1f} GB/s, {:.1f} us per {}", cfg["clock_hz"].get<double>() / 1e6,
+                              cfg["link_model"]["bandwidth_bytes_per_second"].get<double>() / 1e9,
+                              cfg["link_model"]["latency_seconds_per_run"].get<double>() * 1e6, handOvers);
+    else
+      platforms = "rows 'on P' modelled on profile P, latency per " + handOvers;
+    for (const auto& p : cfg.value("profiles", nlohmann::json::array()))
+      platforms += "; profile " + p["summary"].get<std::string>();
     legend = fmt::format(
-        "accelerator = measured host + modelled device ({:.1f} MHz, device cycles with loads, {} backend{}) + "
-        "modelled transfer ({:.1f} GB/s, {:.1f} us per {}; boxes stream through the "
-        "{:g}-byte-a-cycle load port, so only the link's excess over one cycle a box counts)",
-        cfg["clock_hz"].get<double>() / 1e6, cfg["accelerator_backend"].get<std::string>(), keys,
-        cfg["link_model"]["bandwidth_bytes_per_second"].get<double>() / 1e9,
-        cfg["link_model"]["latency_seconds_per_run"].get<double>() * 1e6, handOvers,
-        cfg["link_model"].value("bytes_per_box", 24.0));
+        "accelerator = measured host + modelled device (device cycles with loads, {} backend{}) + modelled transfer "
+        "({}; boxes stream through the {:g}-byte-a-cycle load port, so only the link's excess over one cycle a box "
+        "counts)",
+        cfg["accelerator_backend"].get<std::string>(), keys, platforms, cfg["link_model"].value("bytes_per_box", 24.0));
   }
   header("Median broad-phase time per frame, ms, one thread unless named (" + legend +
          "; ! = missed exact pairs; - = skipped, see below)");

@@ -54,12 +54,16 @@ struct LineUpConfig {
   /// this overlap on x.
   double maxSweepTests = 1e9;
   std::shared_ptr<const DeviceConfig> device;  // the accelerator's; none: no accelerator methods
+  /// The platforms the accelerator is modelled on: its rows once per profile,
+  /// each on that profile's clock and link (withProfile) and named by it.
+  /// Empty: once, on the device's own clock and link.
+  std::vector<DeviceProfile> profiles;
   /// Above 1: the cpu backend also runs on this many threads, per cell size with a tree.
   std::size_t cpuThreads = 0;
 };
 
 /// Bullet's three broad phases, the peers (FCL, CGAL, ODE), then the
-/// accelerator and the cpu backend per cell size.
+/// accelerator (per profile) and the cpu backend per cell size.
 std::vector<MethodSpec> standardLineUp(const LineUpConfig& config);
 /// The line-up's settings for the JSON's configuration.
 nlohmann::json describe(const LineUpConfig& config);

@@ -13,28 +13,12 @@
 #include "device/cpu_backend.hpp"
 #include "device/backend.hpp"
 #include "broad_phase/broad_phase.hpp"
+#include "model/device_profile.hpp"
+#include "model/fpga_report.hpp"
 #include "model/paced_backend.hpp"
 #include "timed_method.hpp"
 
 namespace bpaccel {
-
-/// A device clock and where it came from, for the table's legend.
-struct DeviceClock {
-  double hz = 100e6;
-  std::string source = "default 100 MHz";
-};
-
-/// The default clock of a device with m lanes of architecture `arch` and
-/// `keyWidth`-bit keys: the Fmax that the FPGA flow's report at `fpgaReport`
-/// measured, if that report is a valid result for the same m, architecture
-/// and key width; otherwise 100 MHz, with the reason in `source`. Reports
-/// without "arch" predate the stream architecture and are the seed's; those
-/// without "key_width" are of 32-bit keys.
-DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std::string& arch, int keyWidth = 32);
-
-/// Where the FPGA flow writes the report of that device (make fpga's FPGA_NAME):
-/// results/fpga/[<arch>-]m<m>[-k<width>].json, no prefix for the seed, no suffix for 32-bit keys.
-std::string fpgaReportPath(int m, const std::string& arch, int keyWidth);
 
 /// The device the accelerator methods model, given at run time by the program
 /// that links a hardware configuration (the benchmark library links none).
@@ -45,6 +29,8 @@ struct DeviceConfig {
   double clockHz = 100e6;
   std::string clockSource = "default 100 MHz";
   LinkModel link;                                     // with the device's bytes a box and a result beat
+  /// The platform the clock and link come from (withProfile); none: set by hand, as tests do.
+  std::optional<DeviceProfile> profile;
   /// Cells per hand-over to the device (the hardware's batch front end);
   /// 1 hands each cell over on its own, as before batches existed.
   std::size_t cellsPerBatch = 1;
@@ -57,6 +43,10 @@ struct DeviceConfig {
   /// cellsPerBatch of at least 2.
   bool paced = false;
 };
+
+/// `device` on `profile`'s part and link: its clock, link rates and latency
+/// from the profile, its bytes a box and a result beat its own.
+DeviceConfig withProfile(const DeviceConfig& device, const DeviceProfile& profile);
 
 /// BroadPhase on the device: host part measured, device and link modelled.
 /// With DeviceConfig::paced, the device's answers are recorded in update()
@@ -106,6 +96,7 @@ class CpuMethod final : public TimedMethod {
 
 /// "accelerator k-d C" per cell size (none = no tree, all pairs: skipped above `maxAllPairsTests`);
 /// with the grid partition "accelerator grid C" (none = the same all pairs as k-d none: left out).
+/// A device with a profile names it: "accelerator k-d C on <profile>", and its specs carry the profile.
 std::vector<MethodSpec> acceleratorMethods(std::shared_ptr<const DeviceConfig> device,
                                            const std::vector<std::optional<std::size_t>>& cellSizes,
                                            double maxAllPairsTests, PartitionKind partition = PartitionKind::KdTree);

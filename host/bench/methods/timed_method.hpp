@@ -13,6 +13,8 @@
 #include <string_view>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "model/timeline.hpp"
 #include "core/types.hpp"
 
@@ -88,6 +90,7 @@ struct MethodSpec {
   std::string library;                  // e.g. "Bullet 3.24": the table's blocks per library
   std::optional<std::size_t> cellSize;  // accelerator and cpu: the partition's cell size
   std::string partition;                // accelerator and cpu: "k-d" or "grid"; else empty
+  nlohmann::json profile;               // accelerator: the DeviceProfile it is modelled on (toJson); else null
   /// Why the method cannot run on this scene; nullopt when it can. May be empty.
   std::function<std::optional<std::string>(const SceneStart&)> skipReason;
   std::function<std::unique_ptr<TimedMethod>(const SceneStart&)> make;

@@ -9,9 +9,11 @@ namespace bpaccel {
 /// Boxes stream through the device's load port, one box a cycle, while they
 /// arrive: the load cycles are device time, and the link adds only what it is
 /// slower than the port. Each hand-over (a batch of cells, or a single run)
-/// pays a latency each way; result beats come back over the link.
+/// pays a latency each way; result beats come back over the link. Its rates
+/// are round figures of no part: the benchmark takes them from a
+/// DeviceProfile (device_profile.hpp), which names the platform.
 struct LinkModel {
-  double bandwidthBytesPerSecond = 4e9;  // a PCIe Gen3 x4 link's order of magnitude
+  double bandwidthBytesPerSecond = 4e9;  // each way
   double latencySeconds = 1e-6;          // a command reaching the device, or a completion the host
   double bytesPerBox = 24;               // six keys of the device's key width
   double bytesPerBeat = 4;               // one result beat

@@ -30,10 +30,9 @@
 
 namespace {
 
-// The device the accelerator methods model: this program's Verilated configuration.
-std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, double clockMHz,
-                                                  const std::string& fpgaReport, double linkGBytesPerSecond,
-                                                  double linkLatencyUs, std::size_t cellsPerBatch,
+// The device the accelerator methods model: this program's Verilated
+// configuration; its clock and link come from the profiles it runs on.
+std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, std::size_t cellsPerBatch,
                                                   std::size_t firstBatchCells, bool paced) {
   auto device = std::make_shared<bpaccel::DeviceConfig>();
   device->backend = backend;
@@ -46,16 +45,6 @@ std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, do
                       {"key_width", BPACCEL_KEY_WIDTH},
                       {"run_overhead_cycles", BPACCEL_RUN_OVERHEAD_CYCLES},
                       {"fingerprint", BPACCEL_FINGERPRINT}};
-  if (clockMHz > 0) {
-    device->clockHz = clockMHz * 1e6;
-    device->clockSource = fmt::format("--clock-mhz {}", clockMHz);
-  } else {
-    auto clock = bpaccel::clockFromFpgaReport(fpgaReport, BPACCEL_M, BPACCEL_ARCH, BPACCEL_KEY_WIDTH);
-    device->clockHz = clock.hz;
-    device->clockSource = std::move(clock.source);
-  }
-  device->link.bandwidthBytesPerSecond = linkGBytesPerSecond * 1e9;
-  device->link.latencySeconds = linkLatencyUs * 1e-6;
   device->cellsPerBatch = cellsPerBatch;
   device->firstBatchCells = firstBatchCells;
   device->paced = paced && cellsPerBatch > 1;  // one cell a hand-over has nothing to overlap
@@ -63,11 +52,35 @@ std::shared_ptr<bpaccel::DeviceConfig> makeDevice(const std::string& backend, do
   return device;
 }
 
+// The platforms named by --profiles, for this build's device.
+struct ProfileOptions {
+  std::vector<std::string> names = bpaccel::builtInProfileNames();
+  std::string fpgaDir = "results/fpga";
+  std::string lfe5uReport = bpaccel::fpgaReportPath(BPACCEL_M, BPACCEL_ARCH, BPACCEL_KEY_WIDTH);
+  double clockMHz = 0;  // > 0: every profile's clock, assumed
+  double linkGBytesPerSecond = 4, linkLatencyUs = 1;  // the custom profile's link
+};
+
+std::vector<bpaccel::DeviceProfile> makeProfiles(const ProfileOptions& o) {
+  const bpaccel::ProfileInputs in{.device = {BPACCEL_M, BPACCEL_ARCH, BPACCEL_KEY_WIDTH},
+                                  .fpgaDir = o.fpgaDir,
+                                  .lfe5uReport = o.lfe5uReport};
+  std::vector<bpaccel::DeviceProfile> profiles;
+  for (const auto& name : o.names) {
+    auto p = name == "custom" ? bpaccel::customLinkProfile(in, o.linkGBytesPerSecond * 1e9, o.linkLatencyUs * 1e-6)
+                              : bpaccel::builtInProfile(name, in);
+    if (o.clockMHz > 0)
+      p.part.clockHz = {o.clockMHz * 1e6, bpaccel::Provenance::Assumed, fmt::format("assumed: --clock-mhz {}", o.clockMHz)};
+    profiles.push_back(std::move(p));
+  }
+  return profiles;
+}
+
 int runBench(const bpaccel::BenchConfig& config, bpaccel::LineUpConfig lineUp, const std::vector<std::string>& cells,
              const std::string& jsonPath) {
   lineUp.cellSizes.clear();
   for (const auto& c : cells) lineUp.cellSizes.push_back(bpaccel::parseCellSize(c));
-  if (lineUp.device) fmt::print(stderr, "bench: clock {}\n", lineUp.device->clockSource);
+  for (const auto& p : lineUp.profiles) fmt::print(stderr, "bench: profile {}\n", p.summary());
   bpaccel::Benchmark bench(config, bpaccel::standardLineUp(lineUp), bpaccel::describe(lineUp),
                            [](const std::string& line) { fmt::print(stderr, "bench: {}\n", line); });
   nlohmann::json results;
@@ -138,7 +151,7 @@ int main(int argc, char** argv) {
   lineUp.cpuThreads = std::thread::hardware_concurrency();
   std::vector<std::string> benchCells = {"none", "16", "32", "64", "128", "256"};
   std::string benchBackend = "rtl", benchJson = "results/bench.json";
-  double clockMHz = 0, linkGBytesPerSecond = 4, linkLatencyUs = 1;
+  ProfileOptions profileOptions;
   // As many cells a hand-over as the batch front end queues (its count
   // queue's depth): measured against 16 (grid 64, 8000 objects, model), the
   // serial frame fell by about 4 % (fewer first cells loaded in series and
@@ -151,7 +164,6 @@ int main(int argc, char** argv) {
   // 240 more load cycles.
   std::size_t firstBatchCells = 4;
   bool paced = true;
-  std::string fpgaReport = bpaccel::fpgaReportPath(BPACCEL_M, BPACCEL_ARCH, BPACCEL_KEY_WIDTH);
   auto* benchCmd = app.add_subcommand(
       "run", "Bouncing-cube benchmark: Bullet's, FCL's, CGAL's and ODE's broad phases against the accelerator");
   auto addSceneOptions = [](CLI::App* cmd, bpaccel::SceneConfig& sc) {
@@ -182,14 +194,25 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"rtl", "model"}))->capture_default_str();
   benchCmd->add_option("--frames", bench.frames, "Timed frames per row")->check(CLI::PositiveNumber)->capture_default_str();
   benchCmd->add_option("--warmup", bench.warmup, "Untimed frames before them")->capture_default_str();
-  benchCmd->add_option("--clock-mhz", clockMHz, "Accelerator clock, MHz (default: measured Fmax, else 100 MHz)");
-  benchCmd->add_option("--fpga-report", fpgaReport, "FPGA flow report whose Fmax is the default clock")
+  benchCmd->add_option("--profiles", profileOptions.names,
+                       "Platforms the accelerator rows are modelled on, each row once per profile and named by it: "
+                       "ecp5-5g (LFE5UM5G-85F speed 8, PCIe Gen2 x1), gen3x8 (a PCIe Gen3 x8-class card), custom "
+                       "(the LFE5U-85F with --link-gbytes-per-s and --link-latency-us)")
+      ->check(CLI::IsMember({"ecp5-5g", "gen3x8", "custom"}))->capture_default_str();
+  benchCmd->add_option("--clock-mhz", profileOptions.clockMHz,
+                       "Accelerator clock of every profile, MHz, labelled assumed (default: each profile's part's "
+                       "measured Fmax, or its labelled stand-in)");
+  benchCmd->add_option("--fpga-report", profileOptions.lfe5uReport,
+                       "The LFE5U-85F report whose Fmax is the stand-in clock of parts without their own")
       ->capture_default_str();
-  benchCmd->add_option("--link-gbytes-per-s", linkGBytesPerSecond,
-                       "Modelled link bandwidth in gigabytes per second (1 GB/s = 1e9 bytes/s)")
+  benchCmd->add_option("--fpga-dir", profileOptions.fpgaDir,
+                       "Where the FPGA reports are (the LFE5UM5G-85F's: <design>-*um5g*.json)")
+      ->capture_default_str();
+  benchCmd->add_option("--link-gbytes-per-s", profileOptions.linkGBytesPerSecond,
+                       "The custom profile's link bandwidth in gigabytes per second (1 GB/s = 1e9 bytes/s)")
       ->check(CLI::PositiveNumber)->capture_default_str();
-  benchCmd->add_option("--link-latency-us", linkLatencyUs,
-                       "Modelled latency per hand-over to the accelerator (a batch of cells), microseconds")
+  benchCmd->add_option("--link-latency-us", profileOptions.linkLatencyUs,
+                       "The custom profile's latency per hand-over to the accelerator (a batch of cells), microseconds")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   benchCmd->add_option("--cells-per-batch", cellsPerBatch,
                        "Cells per hand-over to the accelerator (its batch front end); 1: each cell on its own")
@@ -252,9 +275,10 @@ int main(int argc, char** argv) {
     if (*benchCmd) {
       bench.families.clear();
       for (const auto& f : families) bench.families.push_back(bpaccel::parseSceneFamily(f));
-      if (accelerator)
-        lineUp.device = makeDevice(benchBackend, clockMHz, fpgaReport, linkGBytesPerSecond, linkLatencyUs,
-                                   cellsPerBatch, firstBatchCells, paced);
+      if (accelerator) {
+        lineUp.device = makeDevice(benchBackend, cellsPerBatch, firstBatchCells, paced);
+        lineUp.profiles = makeProfiles(profileOptions);
+      }
       return runBench(bench, lineUp, benchCells, benchJson);
     }
     if (*boxesCmd) return runBoxes(boxesConfig, boxesFamily, boxesFrame, boxesOut);

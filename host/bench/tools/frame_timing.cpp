@@ -49,6 +49,7 @@
 #include "broad_phase/broad_phase.hpp"
 #include "core/median.hpp"
 #include "exact_pairs.hpp"
+#include "model/device_profile.hpp"
 #include "model/paced_backend.hpp"
 #include "device/rtl/rtl_backend.hpp"
 #include "scene.hpp"
@@ -95,6 +96,7 @@ int main(int argc, char** argv) {
   std::vector<std::size_t> firstBatchCells;
   std::vector<unsigned> keyWidths;
   double clockMHz = 100;
+  std::string profileName = "gen3x8";
   bool evict = false;
   app.add_option("--objects", objects)->capture_default_str()->check(CLI::PositiveNumber);
   app.add_option("--cell-size", cellSize)->capture_default_str()->check(CLI::PositiveNumber);
@@ -105,6 +107,8 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--clock-mhz", clockMHz, "Device clock of the modelled overlapped frame")->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app.add_option("--profile", profileName, "Device profile whose link the modelled frame uses (bpaccel-bench --profiles)")
+      ->capture_default_str()->check(CLI::IsMember(bpaccel::builtInProfileNames()));
   app.add_option("--backend", backendName)->capture_default_str()->check(CLI::IsMember({"model", "rtl", "cpu"}));
   app.add_option("--frames", frames, "Frames recorded (each timed once a pass)")->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -172,9 +176,11 @@ int main(int argc, char** argv) {
     // The synchronous run's answers.
     std::unique_ptr<bpaccel::AnswerRecording> recording = std::make_unique<bpaccel::AnswerRecording>();
   };
-  bpaccel::PipelineModel model;  // the benchmark's link model (--link-gbytes-per-s 4, --link-latency-us 1)
+  bpaccel::PipelineModel model;
   model.clockHz = clockMHz * 1e6;
-  model.link.bytesPerBeat = static_cast<double>(built.resultBeatBytes());
+  // Only the profile's link: the clock is --clock-mhz.
+  model.link = bpaccel::builtInProfile(profileName, {}).linkModel(static_cast<double>(built.loadBoxBytes()),
+                                                                  static_cast<double>(built.resultBeatBytes()));
   if (paced && (backendName != "model" || cellsPerBatch < 2)) {
     fmt::print(stderr, "frame_timing: --paced needs --backend model and --cells-per-batch of at least 2\n");
     return 2;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <set>
 #include <sys/wait.h>
@@ -257,6 +258,47 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
                         "accelerator k-d 16", "Acceleration over the FASTEST", "Acceleration over the fastest of FCL 0.7",
                         "MODELLED schedule"})
     EXPECT_NE(table.find(s), std::string::npos) << s;
+}
+
+TEST(Benchmark, EveryAcceleratorRowNamesTheProfileItIsModelledOn) {
+  auto l = tinyLineUp();
+  const ProfileInputs in{.device = {8, "stream", 32}, .fpgaDir = "/nonexistent", .lfe5uReport = ""};
+  l.profiles = {ecp5FiveGProfile(in), gen3x8Profile(in)};
+  auto config = tinyConfig();
+  config.objectCounts = {30};
+  config.frames = 1;
+  config.warmup = 0;
+  const auto j = runQuietly(config, standardLineUp(l), l);
+  ASSERT_EQ(j["configuration"]["profiles"].size(), 2u);
+  EXPECT_EQ(j["configuration"]["profiles"][0]["name"], "ecp5-5g");
+  EXPECT_FALSE(j["configuration"].contains("clock_hz"));  // no clock but the profiles'
+  std::map<std::string, std::size_t> perProfile;
+  for (const auto& m : j["rows"][0]["methods"]) {
+    if (m["kind"] != "accelerator") {
+      EXPECT_FALSE(m.contains("profile")) << m["name"];
+      continue;
+    }
+    ASSERT_TRUE(m.contains("profile")) << m["name"];
+    const std::string profile = m["profile"]["name"];
+    const std::string name = m["name"];
+    EXPECT_EQ(name.substr(name.size() - profile.size() - 4), " on " + profile) << name;
+    for (const char* field : {"part", "link", "summary"}) EXPECT_TRUE(m["profile"].contains(field)) << field;
+    EXPECT_EQ(m["profile"]["part"]["clock_hz"]["provenance"], "assumed") << name;  // no report at all here
+    if (!m.contains("skipped")) EXPECT_EQ(m["missing_pairs"], 0) << name;
+    ++perProfile[profile];
+  }
+  // k-d none, 4, 16 and grid 16 on each.
+  EXPECT_EQ(perProfile, (std::map<std::string, std::size_t>{{"ecp5-5g", 4}, {"gen3x8", 4}}));
+  // The slower link costs more transfer time for the same frame.
+  const auto transfer = [&](const std::string& name) {
+    for (const auto& m : j["rows"][0]["methods"])
+      if (m["name"] == name) return m["transfer_ms_modelled"]["median"].get<double>();
+    return -1.0;
+  };
+  EXPECT_GT(transfer("accelerator k-d 16 on ecp5-5g"), transfer("accelerator k-d 16 on gen3x8"));
+  const std::string table = Benchmark::table(j);
+  EXPECT_NE(table.find("accelerator k-d 16 on gen3x8"), std::string::npos);
+  EXPECT_NE(table.find("profile ecp5-5g: LFE5UM5G-85F speed 8"), std::string::npos) << table;
 }
 
 TEST(Benchmark, AnExactMethodThatMissesAPairFailsTheRunWithTheCount) {
@@ -663,7 +705,17 @@ TEST(BenchCli, NamesTheLinkUnitAndListsSkippedMethodsInTableAndJson) {
   const auto j = nlohmann::json::parse(in);
   std::size_t skipped = 0;
   for (const auto& m : j["rows"][0]["methods"]) skipped += m.contains("skipped");
-  EXPECT_EQ(skipped, 3u);  // btSimpleBroadphase, accelerator and cpu without the tree
+  EXPECT_EQ(skipped, 4u);  // btSimpleBroadphase, the accelerator on each profile and cpu without the tree
+  // Every accelerator row names its profile, by default both built-in ones, in its name and its JSON.
+  std::set<std::string> profiles;
+  for (const auto& m : j["rows"][0]["methods"])
+    if (m["kind"] == "accelerator") {
+      const std::string profile = m["profile"]["name"];
+      EXPECT_NE(m["name"].get<std::string>().find(" on " + profile), std::string::npos) << m["name"];
+      profiles.insert(profile);
+    }
+  EXPECT_EQ(profiles, (std::set<std::string>{"ecp5-5g", "gen3x8"}));
+  EXPECT_EQ(j["configuration"]["profiles"].size(), 2u);
   std::filesystem::remove(json);
 }
 
