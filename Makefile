@@ -23,12 +23,17 @@ KEY_WIDTH ?= 32
 # inferred too: ecp5-outreg was not measured faster at m = 8 (docs/fpga.md).
 MEMORY_STYLE ?=
 FPGA_MEMORY_STYLE ?=
+# The ECP5 part `make fpga` places on (scripts/fpga/fpgaflow/ecp5.py PARTS):
+# lfe5u-85f (speed 6) or lfe5um5g-85f (speed 8); empty: the flow's default,
+# lfe5u-85f. Another part names the report with a suffix.
+FPGA_PART ?=
 EMIT_ARGS = --arch $(ARCH) --m $(M) --key-width $(KEY_WIDTH) $(if $(CAPACITY),--capacity $(CAPACITY))
 # Folder and report names come from one rule (scripts/fpga/fpgaflow/names.py).
 NAMES = $(PYTHON) scripts/fpga/names.py --arch $(ARCH) --m $(M) --key-width $(KEY_WIDTH) $(if $(CAPACITY),--capacity $(CAPACITY))
 DESIGN_NAME := $(shell $(NAMES))
 KEY_SUFFIX  := $(shell $(NAMES) --key-suffix)
-FPGA_NAME   := $(shell $(NAMES) $(if $(FPGA_MEMORY_STYLE),--memory-style $(FPGA_MEMORY_STYLE)))
+FPGA_DESIGN := $(shell $(NAMES) $(if $(FPGA_MEMORY_STYLE),--memory-style $(FPGA_MEMORY_STYLE)))
+FPGA_NAME   := $(shell $(NAMES) $(if $(FPGA_MEMORY_STYLE),--memory-style $(FPGA_MEMORY_STYLE)) $(if $(FPGA_PART),--part $(FPGA_PART)))
 VERILOG_DIR ?= generated/$(shell $(NAMES) $(if $(MEMORY_STYLE),--memory-style $(MEMORY_STYLE)))
 
 # The host is built for one configuration: ARCH, M, CAPACITY and KEY_WIDTH
@@ -167,11 +172,12 @@ test-fuzz: fuzz
 fuzz-long: fuzz
 	nice host/fuzz/run.sh --runs $(FUZZ_BUILD) $(FUZZ_RUNS)
 
-# FPGA flow (docs/fpga.md): ECP5 synthesis, place and route with a measured
-# Fmax, and a Xilinx 7-series synthesis estimate.
+# FPGA flow (docs/fpga.md): ECP5 synthesis, place and route on FPGA_PART with
+# a measured Fmax, and a Xilinx 7-series synthesis estimate. The Verilog does
+# not depend on the part: its folder is named by the design alone.
 fpga: deps
-	$(MAKE) verilog ARCH=$(ARCH) M=$(M) CAPACITY=$(CAPACITY) KEY_WIDTH=$(KEY_WIDTH) MEMORY_STYLE=$(FPGA_MEMORY_STYLE) VERILOG_DIR=build/fpga-verilog/$(FPGA_NAME)
-	$(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/$(FPGA_NAME) --out results/fpga/$(FPGA_NAME).json $(FPGA_ARGS)
+	$(MAKE) verilog ARCH=$(ARCH) M=$(M) CAPACITY=$(CAPACITY) KEY_WIDTH=$(KEY_WIDTH) MEMORY_STYLE=$(FPGA_MEMORY_STYLE) VERILOG_DIR=build/fpga-verilog/$(FPGA_DESIGN)
+	$(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/$(FPGA_DESIGN) --out results/fpga/$(FPGA_NAME).json $(if $(FPGA_PART),--part $(FPGA_PART)) $(FPGA_ARGS)
 
 fpga-sweep: deps
 	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --key-width $(KEY_WIDTH) $(if $(CAPACITY),--capacity $(CAPACITY)) $(if $(FPGA_MEMORY_STYLE),--memory-style $(FPGA_MEMORY_STYLE)) --verilog-root build/fpga-verilog --emit always --budget-min 60

@@ -12,7 +12,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))  # the flow's package, for the tests that need no tools
-from fpgaflow import ecp5, tools  # noqa: E402
+from fpgaflow import ecp5, names, tools  # noqa: E402
 
 VERILOG_DIRS: dict[str, Path] = {}
 FLOWS: dict[str, tuple[subprocess.Popen, Path, Path, Path]] = {}  # arch: (its run, report, work dir, output)
@@ -61,6 +61,7 @@ class FlowOnSmallConfiguration(unittest.TestCase):
         self.assertTrue(r["fits"])
         self.assertEqual(r["m"], 2)
         self.assertEqual(r["arch"], self.ARCH)
+        self.assertEqual(r["part"]["ecp5_part"], ecp5.PARTS[names.DEFAULT_PART].facts())
         # The commit of the design it measured (this test runs in a clone).
         self.assertRegex(r["source_revision"] or "", r"^[0-9a-f]{7,40}(-dirty)?$")
         e = r["ecp5"]
@@ -106,6 +107,45 @@ class FlowOnSmallStreamConfiguration(FlowOnSmallConfiguration):
         # input: merged (opt_merge), their names would be aliases of one net.
         for enable in ("windowWrite", "aLoad", "headCopy", "headShift", "aNextWrite"):
             self.assertNotEqual(bits(f"{enable}_replica0"), bits(f"{enable}_replica1"), enable)
+
+
+class PartsToPlaceOn(unittest.TestCase):
+    """Each ECP5 part the flow offers is one nextpnr-ecp5 places on as described
+    (device, package, speed grade), and a report names its part."""
+    NETLIST = "module top(input a, output y); assign y = ~a; endmodule\n"
+
+    def nextpnr_accepts(self, args: list[str]) -> subprocess.CompletedProcess:
+        with tempfile.TemporaryDirectory() as d:
+            work = Path(d)
+            (work / "top.v").write_text(self.NETLIST)
+            bins = tools.ensure_venv(tools.REPO / ".venv")
+            synth = subprocess.run([str(bins["yosys"]), "-q", "-p", "synth_ecp5 -top top -json top.json", "top.v"],
+                                   cwd=work, capture_output=True, text=True)
+            self.assertEqual(synth.returncode, 0, synth.stderr[-2000:])
+            return subprocess.run([str(bins["nextpnr"]), *args, "--json", "top.json", "--lpf-allow-unconstrained",
+                                   "--report", "report.json", "--quiet"], cwd=work, capture_output=True, text=True)
+
+    def test_nextpnr_places_on_each_part_as_described(self):
+        self.assertEqual(ecp5.PARTS[names.DEFAULT_PART].name, "LFE5U-85F")
+        self.assertEqual(ecp5.PARTS["lfe5um5g-85f"].speed, 8)
+        for part in ecp5.PARTS.values():
+            run = self.nextpnr_accepts(part.nextpnr_args())
+            self.assertEqual(run.returncode, 0, (part, run.stdout[-2000:], run.stderr[-2000:]))
+        # A speed grade nextpnr-ecp5 does not time the 5G part at is refused: the check above can fail.
+        wrong = ecp5.Part("x", "LFE5UM5G-85F", "--um5g-85k", "CABGA381", 6)
+        self.assertNotEqual(self.nextpnr_accepts(wrong.nextpnr_args()).returncode, 0)
+
+    def test_names_a_report_by_its_part_only_when_not_the_default(self):
+        self.assertEqual(names.design_name("stream", 64), "stream-m64")
+        self.assertEqual(names.design_name("stream", 64, part=names.DEFAULT_PART), "stream-m64")
+        self.assertEqual(names.design_name("stream", 64, 16, part="lfe5um5g-85f"), "stream-m64-k16-lfe5um5g-85f")
+
+    def test_refuses_a_part_it_does_not_know(self):
+        with tempfile.TemporaryDirectory() as empty:
+            run = subprocess.run([sys.executable, str(HERE / "flow.py"), "--verilog-dir", empty, "--part", "lfe5u-45f"],
+                                 capture_output=True, text=True)
+            self.assertEqual(run.returncode, 2)
+            self.assertIn("--part", run.stderr)
 
 
 class FlowRefusesBadInput(unittest.TestCase):

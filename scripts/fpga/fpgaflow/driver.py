@@ -1,7 +1,7 @@
 """FPGA synthesis / place-and-route flow for one emitted configuration of BroadPhaseAccel.
 
-ECP5 (measured): Yosys `synth_ecp5` then `nextpnr-ecp5` place and route on a
-LFE5U-85F; resources and the maximum clock frequency come from nextpnr's own
+ECP5 (measured): Yosys `synth_ecp5` then `nextpnr-ecp5` place and route on
+--part (LFE5U-85F speed 6 by default, or LFE5UM5G-85F speed 8); resources and the maximum clock frequency come from nextpnr's own
 report of the placed-and-routed design.
 
 Xilinx 7-series (estimate): Debian's Yosys `synth_xilinx -family xc7`;
@@ -37,7 +37,7 @@ from pathlib import Path
 
 from . import breakdown, ecp5, report, xilinx
 from .design import Design, read_params
-from .names import params_name
+from .names import DEFAULT_PART, params_name
 from .tools import (DEBIAN_YOSYS, EXIT_INPUT, EXIT_NOFIT, EXIT_OK, REPO, FlowError, Runner, Tools, log)
 
 
@@ -50,6 +50,9 @@ def arguments(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--out", type=Path,
                     help="JSON report (default results/fpga/<name>.json, the name from scripts/fpga/fpgaflow/names.py)")
     ap.add_argument("--venv", type=Path, default=REPO / ".venv", help="virtual env for the yowasp tools")
+    ap.add_argument("--part", choices=sorted(ecp5.PARTS), default=DEFAULT_PART,
+                    help="ECP5 part to place on (fpgaflow/ecp5.py PARTS); a part other than the default "
+                         "names the report with a suffix")
     ap.add_argument("--clock-mhz", type=float, default=200.0, help="clock constraint given to nextpnr")
     ap.add_argument("--work-dir", type=Path, help="scratch dir (default: work/<name of --out without .json> beside --out)")
     ap.add_argument("--seed", type=int, default=1, help="nextpnr placer seed")
@@ -80,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
 def paths(args) -> tuple[Path, Path]:
     """The report and the work dir."""
     params = read_params(args.verilog_dir.resolve(), args.m)
-    out = (args.out or REPO / "results" / "fpga" / f"{params_name(params)}.json").resolve()
+    out = (args.out or REPO / "results" / "fpga" / f"{params_name(params, args.part)}.json").resolve()
     return out, (args.work_dir or out.parent / "work" / out.stem).resolve()
 
 
@@ -100,8 +103,8 @@ def flow(args) -> int:
     design.read_structure(runner, tools.yosys)
     wrapper_info = design.write_wrapper()
     synthesis = ecp5.synthesise(runner, tools.yosys, design)
-    pnr = ecp5.place_and_route(runner, tools.nextpnr, work, args.clock_mhz, args.seed, args.router,
-                               args.threads, args.placer)
+    pnr = ecp5.place_and_route(runner, tools.nextpnr, work, ecp5.PARTS[args.part], args.clock_mhz, args.seed,
+                               args.router, args.threads, args.placer)
     estimate = None if args.no_xilinx else xilinx.estimate(runner, args.debian_yosys, design)
     area = None if args.no_breakdown else breakdown.breakdown(runner, tools.yosys, design, synthesis)
 

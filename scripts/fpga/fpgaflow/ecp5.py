@@ -1,6 +1,7 @@
 """ECP5 (measured): Yosys synth_ecp5 of the wrapped core, then nextpnr-ecp5 place
-and route on a LFE5U-85F; resources and the maximum clock frequency come from
-nextpnr's own report of the placed-and-routed design."""
+and route on one of PARTS (the LFE5U-85F unless told otherwise); resources and
+the maximum clock frequency come from nextpnr's own report of the
+placed-and-routed design."""
 from __future__ import annotations
 
 import json
@@ -11,15 +12,39 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .design import WRAPPER_TOP, Design
+from .names import DEFAULT_PART
 from .tools import EXIT_INPUT, EXIT_TOOL, KEEP_REPLICAS, FlowError, Runner, log, memory_mapping, stat_cells
 
-# The device: the largest ECP5 (LFE5U-85F). CABGA381 is the package of the
-# common 85k boards (ULX3S, ECP5 evaluation board); only 4 pins are used.
-DEVICE_FLAG = "--85k"
-PART = "LFE5U-85F"
-PACKAGE = "CABGA381"
-SPEED = "6"  # nextpnr-ecp5's default speed grade for --85k
-PART_TEXT = f"{PART} {PACKAGE} speed {SPEED} (nextpnr-ecp5 {DEVICE_FLAG} --package {PACKAGE})"
+
+@dataclass(frozen=True)
+class Part:
+    """An ECP5 part nextpnr-ecp5 places on: its name, the device flag, package and speed grade."""
+    key: str          # --part value and report-name suffix (scripts/fpga/fpgaflow/names.py)
+    name: str
+    device_flag: str
+    package: str
+    speed: int
+
+    def nextpnr_args(self) -> list[str]:
+        return [self.device_flag, "--package", self.package, "--speed", str(self.speed)]
+
+    def text(self) -> str:
+        return f"{self.name} {self.package} speed {self.speed} (nextpnr-ecp5 {' '.join(self.nextpnr_args())})"
+
+    def facts(self) -> dict:
+        return {"part": self.name, "package": self.package, "speed_grade": self.speed,
+                "nextpnr_args": " ".join(self.nextpnr_args())}
+
+
+# The 85k ECP5 parts in CABGA381, the package of the common 85k boards (ULX3S,
+# the ECP5 evaluation boards); only 4 pins are used. The LFE5U-85F has no
+# transceivers; the LFE5UM5G-85F has them (5G SERDES), and nextpnr-ecp5 times
+# 5G parts at speed grade 8 only.
+PARTS = {p.key: p for p in (
+    Part("lfe5u-85f", "LFE5U-85F", "--85k", "CABGA381", 6),
+    Part("lfe5um5g-85f", "LFE5UM5G-85F", "--um5g-85k", "CABGA381", 8),
+)}
+assert DEFAULT_PART in PARTS
 
 # How Yosys names a coordinate memory in its log (module mem_<depth>x<width>, instance mem*_ext).
 COORD_MEMORY_RE = r"\S*mem\S*"
@@ -186,12 +211,12 @@ class PlaceAndRoute:
         return {k: v for k, v in self.utilisation.items() if v["used"] > v["available"]}
 
 
-def place_and_route(runner: Runner, nextpnr: str, work: Path, clock_mhz: float, seed: int, router: str,
-                    threads: int, placer: str | None) -> PlaceAndRoute:
-    """nextpnr-ecp5 on ecp5.json: a routed design, or one that does not fit the device."""
+def place_and_route(runner: Runner, nextpnr: str, work: Path, part: Part, clock_mhz: float, seed: int,
+                    router: str, threads: int, placer: str | None) -> PlaceAndRoute:
+    """nextpnr-ecp5 on ecp5.json, placed on `part`: a routed design, or one that does not fit the device."""
     help_text = subprocess.run([nextpnr, "--help"], cwd=work, stdout=subprocess.PIPE,
                                stderr=subprocess.STDOUT, text=True).stdout
-    cmd = [nextpnr, DEVICE_FLAG, "--package", PACKAGE, "--json", "ecp5.json", "--lpf-allow-unconstrained",
+    cmd = [nextpnr, *part.nextpnr_args(), "--json", "ecp5.json", "--lpf-allow-unconstrained",
            "--freq", f"{clock_mhz:g}", "--timing-allow-fail", "--seed", str(seed), "--router", router,
            "--report", "nextpnr_report.json"]
     if "--threads" in help_text:

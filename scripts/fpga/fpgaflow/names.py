@@ -3,7 +3,7 @@
 A name is the architecture's prefix (none for the seed, whose reports keep
 their names), m, then only what differs from the defaults: the capacity when
 one is asked for, the key width when not 32, the memory style when not the
-flow's. `make` calls this (scripts/fpga/names.py) for its folders and
+flow's, the ECP5 part when not the flow's (fpgaflow/ecp5.py PARTS). `make` calls this (scripts/fpga/names.py) for its folders and
 results/fpga/<name>.json; sweep.py and flow.py import it.
 """
 from __future__ import annotations
@@ -15,6 +15,9 @@ from pathlib import Path
 # the generator's default too); reports of another carry it as a suffix.
 FLOW_MEMORY_STYLE = "inferred"
 DEFAULT_KEY_WIDTH = 32
+# The ECP5 part `make fpga` places on unless told otherwise (a key of
+# fpgaflow/ecp5.py PARTS); reports of another carry it as a suffix.
+DEFAULT_PART = "lfe5u-85f"
 
 
 def prefix(arch: str) -> str:
@@ -26,21 +29,24 @@ def key_suffix(key_width: int) -> str:
 
 
 def design_name(arch: str, m: int, key_width: int = DEFAULT_KEY_WIDTH, capacity: int | None = None,
-                memory_style: str | None = None) -> str:
-    """stream-m8, m8 (seed), stream-m64-c4096-k16, stream-m8-ecp5-outreg, ..."""
+                memory_style: str | None = None, part: str | None = None) -> str:
+    """stream-m8, m8 (seed), stream-m64-c4096-k16, stream-m8-ecp5-outreg, stream-m64-lfe5um5g-85f, ..."""
     name = f"{prefix(arch)}m{m}"
     if capacity is not None:
         name += f"-c{capacity}"
     name += key_suffix(key_width)
     if memory_style and memory_style != FLOW_MEMORY_STYLE:
         name += f"-{memory_style}"
+    if part and part != DEFAULT_PART:
+        name += f"-{part}"
     return name
 
 
-def params_name(params: dict) -> str:
-    """The name of the design a bpaccel_params.json describes (its capacity named only when not the default)."""
+def params_name(params: dict, part: str | None = None) -> str:
+    """The name of the design a bpaccel_params.json describes (its capacity named only when not the
+    default), placed on `part`."""
     capacity = params["capacity"] if params["capacity"] != params["default_capacity"] else None
-    return design_name(params["arch"], params["m"], params["key_width"], capacity, params["memory_style"])
+    return design_name(params["arch"], params["m"], params["key_width"], capacity, params["memory_style"], part)
 
 
 def sweep_file(arch: str, key_width: int) -> str:
@@ -56,14 +62,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--key-width", type=int, default=DEFAULT_KEY_WIDTH)
     ap.add_argument("--capacity", type=int)
     ap.add_argument("--memory-style")
+    ap.add_argument("--part", help=f"ECP5 part (fpgaflow/ecp5.py PARTS; default {DEFAULT_PART})")
     ap.add_argument("--key-suffix", action="store_true", help="print only the key width's suffix")
     args = ap.parse_args(argv)
     if args.key_suffix:
         print(key_suffix(args.key_width))
     elif args.params:
-        print(params_name(json.loads(args.params.read_text())))
+        print(params_name(json.loads(args.params.read_text()), args.part))
     elif args.arch and args.m:
-        print(design_name(args.arch, args.m, args.key_width, args.capacity, args.memory_style))
+        print(design_name(args.arch, args.m, args.key_width, args.capacity, args.memory_style, args.part))
     else:
         ap.error("give --params, or --arch and --m")
     return 0
