@@ -146,6 +146,15 @@ nlohmann::json runRow(const QueryBenchConfig& config, std::size_t objects,
   contenders.push_back({"btDbvtBroadphase", std::make_unique<btDbvtBroadphase>(), {}, {}, {}, {}, {}});
   contenders.push_back({"bpaccel::BulletDropIn, cpu backend", std::make_unique<BulletDropIn>(std::make_unique<CpuBackend>()),
                         {}, {}, {}, {}, {}});
+  // btDbvtBroadphase frees a proxy only in destroyProxy: release every proxy before the broad phases go.
+  struct ProxyRelease {
+    std::vector<Contender>& contenders;
+    btDispatcher* dispatcher;
+    ~ProxyRelease() {
+      for (auto& c : contenders)
+        for (btBroadphaseProxy* p : c.proxies) c.bp->destroyProxy(p, dispatcher);
+    }
+  } release{contenders, &dispatcher};
   for (auto& c : contenders)
     for (std::size_t i = 0; i < boxes.size(); ++i)
       c.proxies.push_back(c.bp->createProxy(vec(boxes[i].min), vec(boxes[i].max), BOX_SHAPE_PROXYTYPE,

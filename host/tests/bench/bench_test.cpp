@@ -777,7 +777,8 @@ TEST(Benchmark, TheCpuBackendsAutomaticChoiceRunsExactlyBesideTheFixedOnes) {
   EXPECT_EQ(exactCpuRowsNamed(1, "cpu auto"), std::vector<std::string>{"cpu auto"});
   auto l = tinyLineUp();
   l.cpuThreads = 1;
-  for (const auto& m : runQuietly(tinyConfig(), standardLineUp(l), l)["rows"][0]["methods"])
+  const auto json = runQuietly(tinyConfig(), standardLineUp(l), l);  // a range-for over its subscript would outlive it
+  for (const auto& m : json["rows"][0]["methods"])
     if (m["name"] == "cpu auto") {
       EXPECT_EQ(m["cell_size"], "auto");
       EXPECT_EQ(m["partition"], "auto");

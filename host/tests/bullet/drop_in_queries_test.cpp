@@ -66,6 +66,14 @@ struct TwoBroadPhases {
   BulletDropIn mine{std::make_unique<bpaccel::CpuBackend>()};
   std::vector<btBroadphaseProxy*> dbvtProxies, myProxies;  // by id; null once destroyed
 
+  // btDbvtBroadphase frees a proxy only in destroyProxy, as a Bullet world does when it removes an object.
+  ~TwoBroadPhases() {
+    for (std::size_t id = 0; id < myProxies.size(); ++id) {
+      if (dbvtProxies[id]) dbvt.destroyProxy(dbvtProxies[id], &dispatcher);
+      if (myProxies[id]) mine.destroyProxy(myProxies[id], &dispatcher);
+    }
+  }
+
   void add(int id, const Aabb& b) {
     if (static_cast<std::size_t>(id) >= myProxies.size()) {
       dbvtProxies.resize(static_cast<std::size_t>(id) + 1, nullptr);
