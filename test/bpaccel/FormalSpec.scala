@@ -49,10 +49,7 @@ object FormalConfigs {
   * reset (ChiselTest 6.0.0 has no induction), with boxes, counts, load/start
   * timing and the consumer's `ready` all free.
   *
-  * Solver: z3 from PyPI, pinned in scripts/deps.sh and first on the tests'
-  * PATH (build.sbt): Debian's z3 4.8.12 does not get past parsing
-  * ChiselTest's encoding of this design, and Debian's CVC4 1.8 did not reach
-  * a whole run in 35 minutes (docs/verification.md).
+  * Solvers: [[FormalSolver]] (Yices 2 proves, z3 refutes; docs/verification.md).
   *
   * The proofs are [[FormalSpec]]; each property's mutant, the same check on
   * a design with one deliberate bug ([[Fault]]) that must fail with that
@@ -60,18 +57,6 @@ object FormalConfigs {
   * two run side by side.
   */
 trait FormalChecks extends ChiselScalatestTester with Formal with Matchers { this: AnyFlatSpec =>
-  private val engine = Z3EngineAnnotation
-
-  /** The z3 on the tests' PATH, checked once: an older one would not fail but take hours. */
-  private lazy val solverChecked: Unit = {
-    val out = scala.util.Try(scala.sys.process.Process(Seq("z3", "--version")).!!.trim).getOrElse("no z3 on PATH")
-    val version = """Z3 version (\d+)\.(\d+)""".r.findFirstMatchIn(out).map(m => (m.group(1).toInt, m.group(2).toInt))
-    assert(
-      version.exists { case (major, minor) => major > 4 || (major == 4 && minor >= 13) },
-      s"the formal checks need z3 4.13 or later (run make deps, which installs it into build/formal-tools); found: $out"
-    )
-  }
-
   private def dir(name: String) = TargetDirAnnotation(s"test_run_dir/formal/$name")
 
   private def timed[T](body: => T): (T, Double) = {
@@ -81,8 +66,7 @@ trait FormalChecks extends ChiselScalatestTester with Formal with Matchers { thi
   }
 
   def prove(name: String, p: AccelParams, depth: Int, properties: Set[Property] = Property.all.toSet): Unit = {
-    solverChecked
-    val (_, s) = timed(verify(new FormalHarness(p, properties), Seq(BoundedCheck(depth), engine, dir(name))))
+    val (_, s) = timed(verify(new FormalHarness(p, properties), Seq(BoundedCheck(depth), FormalSolver.prover, dir(name))))
     info(f"${p.arch.name} m=${p.m} capacity=${p.capacity}: no violation within $depth cycles of reset ($s%.1f s)")
   }
 
@@ -91,13 +75,12 @@ trait FormalChecks extends ChiselScalatestTester with Formal with Matchers { thi
     * assertions stay on too, so the message is what tells them apart).
     */
   def refute(fault: Fault, property: Property, p: AccelParams, depth: Int): Unit = {
-    solverChecked
     val printed = new ByteArrayOutputStream()
     val (e, s) = timed(Console.withOut(printed) {
       intercept[FailedBoundedCheckException] {
         verify(
           new FormalHarness(p.copy(faults = Set(fault)), Set(property)),
-          Seq(BoundedCheck(depth), engine, dir(s"mutant-${fault.toString}"))
+          Seq(BoundedCheck(depth), FormalSolver.refuter, dir(s"mutant-${fault.toString}"))
         )
       }
     })

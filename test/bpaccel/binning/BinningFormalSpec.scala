@@ -9,10 +9,11 @@ import firrtl2.options.TargetDirAnnotation
 import org.scalatest.flatspec.AnyFlatSpec
 import org.scalatest.matchers.should.Matchers
 
-import bpaccel.FormalLong
+import bpaccel.{FormalLong, FormalSolver}
+import chiseltest.formal.backends.FormalEngineAnnotation
 
 /** Formal checks of the binning device: bounded model checking from reset
-  * with z3 (as bpaccel.FormalSpec), every input free, in three families: a
+  * with bpaccel.FormalSolver (as bpaccel.FormalSpec), every input free, in three families: a
   * group's schedule, the output path, the whole core. `make test` runs a
   * shallow proof of each family and the schedule's cheapest mutant;
   * `make formal-long` (tag FormalLong) the deeper proofs, over whole runs,
@@ -21,7 +22,7 @@ import bpaccel.FormalLong
   */
 class BinningFormalSpec extends AnyFlatSpec with ChiselScalatestTester with Formal with Matchers {
   /** g lanes, 1-bit offsets, `entries` positions, no memory output registers, queues of three: a
-    * queue's memory of one or two rows has an address of one bit or none, and z3 may describe such a
+    * queue's memory of one or two rows has an address of one bit or none, and a solver may describe such a
     * memory in a counterexample as a lambda, "(lambda ((x!1 Bool)) x!1)", which ChiselTest cannot
     * read back ("TODO implement parsing of SMT solver response").
     */
@@ -33,11 +34,11 @@ class BinningFormalSpec extends AnyFlatSpec with ChiselScalatestTester with Form
   private def timed[T](body: => T): (T, Double) = {
     val t0 = System.nanoTime(); val r = body; (r, (System.nanoTime() - t0) / 1e9)
   }
-  private def annotations(name: String, depth: Int) =
-    Seq(BoundedCheck(depth), Z3EngineAnnotation, TargetDirAnnotation(s"test_run_dir/binning-formal/$name"))
+  private def annotations(name: String, depth: Int, engine: FormalEngineAnnotation) =
+    Seq(BoundedCheck(depth), engine, TargetDirAnnotation(s"test_run_dir/binning-formal/$name"))
 
   def prove(name: String, harness: => Module, depth: Int): Unit = {
-    val (_, s) = timed(verify(harness, annotations(name, depth)))
+    val (_, s) = timed(verify(harness, annotations(name, depth, FormalSolver.prover)))
     info(f"no violation within $depth cycles of reset ($s%.1f s)")
   }
 
@@ -45,7 +46,7 @@ class BinningFormalSpec extends AnyFlatSpec with ChiselScalatestTester with Form
   def refute(name: String, fault: BinningFault, property: BinProperty, harness: => Module, depth: Int): Unit = {
     val printed = new ByteArrayOutputStream()
     val (e, s) = timed(Console.withOut(printed) {
-      intercept[FailedBoundedCheckException](verify(harness, annotations(s"mutant-$name", depth)))
+      intercept[FailedBoundedCheckException](verify(harness, annotations(s"mutant-$name", depth, FormalSolver.refuter)))
     })
     withClue(s"replay of the counterexample:\n$printed\n") { printed.toString should include(s"[${property.name}]") }
     info(f"${fault.description}: caught by ${property.name} ${e.failAt} steps after reset ($s%.1f s)")
