@@ -168,7 +168,7 @@ fuzz: deps
 test-fuzz: fuzz
 	host/fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS)
 
-# The long run: FUZZ_RUNS executions of each target, one after the other.
+# The long run: FUZZ_RUNS executions of each target, side by side.
 fuzz-long: fuzz
 	nice host/fuzz/run.sh --runs $(FUZZ_BUILD) $(FUZZ_RUNS)
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs every fuzz target of build dir $1, one after the other, either for $2
+# Runs every fuzz target of build dir $1, side by side, either for $2
 # seconds each (time mode) or for $2 executions each (--runs mode). Each
 # starts from the committed seeds (host/fuzz/corpus/<target>, never written)
 # plus a working corpus in the build dir, so every committed reproducer is
@@ -14,18 +14,17 @@ amount=${2:?seconds or executions}
 here=$(cd "$(dirname "$0")" && pwd)
 
 mkdir -p "$build/artifacts"
-for target in box_file pairs; do
-  work="$build/work/$target"
+
+# One target: its search, then its verdict. Prints and returns nonzero on a finding.
+fuzz_target() {
+  local target=$1 work="$build/work/$1" log="$build/$1.log" status=0
   mkdir -p "$work"
-  dict=()
+  local dict=()
   [ -f "$here/$target.dict" ] && dict=(-dict="$here/$target.dict")
   # A pairs input of 512 bytes holds up to about 70 boxes: enough for chunked
   # cells and many leaves, and the brute force stays cheap.
-  max_len=4096
+  local max_len=4096
   [ "$target" = pairs ] && max_len=512
-  log="$build/$target.log"
-  echo "fuzz: $target ($mode=$amount), log in $log"
-  status=0
   "$build/${target}_fuzzer" "$mode=$amount" -timeout=10 -rss_limit_mb=2048 -max_len=$max_len -print_final_stats=1 \
     -artifact_prefix="$build/artifacts/$target-" "${dict[@]}" "$work" "$here/corpus/$target" >"$log" 2>&1 ||
     status=$?
@@ -34,6 +33,18 @@ for target in box_file pairs; do
     tail -n 40 "$log" >&2
     echo "fuzz: $target FAILED (exit $status); the input is in $build/artifacts/, replay it with" \
       "$build/${target}_fuzzer <file>" >&2
-    exit 1
+    return 1
   fi
+}
+
+# The targets side by side: each is single-threaded.
+targets=(box_file pairs)
+pids=()
+for target in "${targets[@]}"; do
+  echo "fuzz: $target ($mode=$amount), log in $build/$target.log"
+  fuzz_target "$target" &
+  pids+=($!)
 done
+failed=0
+for pid in "${pids[@]}"; do wait "$pid" || failed=1; done
+exit $failed
