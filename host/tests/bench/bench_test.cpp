@@ -702,8 +702,8 @@ TEST(DeviceClock, TheDefaultClockIsTheFmaxOfAReportOfTheSameMAndArchitectureOnly
 namespace {
 
 // Runs the real bpaccel binary; returns its exit code and standard output.
-std::pair<int, std::string> runBenchCli(const std::string& args) {
-  const std::string cmd = std::string(BPACCEL_BENCH_CLI) + " run " + args + " 2>/dev/null";
+std::pair<int, std::string> runBenchCli(const std::string& args, const std::string& subcommand = "run") {
+  const std::string cmd = std::string(BPACCEL_BENCH_CLI) + " " + subcommand + " " + args + " 2>/dev/null";
   std::string out;
   FILE* pipe = ::popen(cmd.c_str(), "r");
   std::array<char, 4096> buf{};
@@ -722,10 +722,12 @@ TEST(BenchCli, NamesTheLinkUnitAndListsSkippedMethodsInTableAndJson) {
 
   const auto json = std::filesystem::temp_directory_path() / ("bpaccel-bench-" + std::to_string(::getpid()) + ".json");
   const auto [code, table] = runBenchCli("--objects 40 --frames 1 --warmup 0 --backend model --cell-sizes none 8 "
-                                         "--max-all-pairs-tests 100 --json " + json.string());
+                                         "--max-all-pairs-tests 100 --many-worlds 8 --world-sizes 10 --world-frames 1 "
+                                         "--json " + json.string());
   EXPECT_EQ(code, 0) << table;
   EXPECT_NE(table.find("n=40 btSimpleBroadphase: skipped: tests all pairs"), std::string::npos) << table;
   EXPECT_NE(table.find("n=40 cpu k-d none: skipped"), std::string::npos) << table;
+  EXPECT_NE(table.find("Many worlds: 8 worlds of n boxes"), std::string::npos) << table;
   std::ifstream in(json);
   const auto j = nlohmann::json::parse(in);
   std::size_t skipped = 0;
@@ -741,6 +743,19 @@ TEST(BenchCli, NamesTheLinkUnitAndListsSkippedMethodsInTableAndJson) {
     }
   EXPECT_EQ(profiles, (std::set<std::string>{"ecp5-5g", "gen3x8"}));
   EXPECT_EQ(j["configuration"]["profiles"].size(), 2u);
+  std::filesystem::remove(json);
+}
+
+TEST(BenchCli, TheManyWorldsTableRunsInTheBenchAndAlone) {
+  const auto json = std::filesystem::temp_directory_path() / ("bpaccel-worlds-" + std::to_string(::getpid()) + ".json");
+  const auto [code, table] = runBenchCli("--worlds 8 --world-sizes 10 20 --world-frames 1 --world-warmup 0 --backend model "
+                                         "--json " + json.string(), "worlds");
+  EXPECT_EQ(code, 0) << table;
+  for (const char* s : {"Many worlds: 8 worlds", "n=20", "accelerator ManyWorlds on ecp5-5g", "Every world of every frame validated"})
+    EXPECT_NE(table.find(s), std::string::npos) << s << "\n" << table;
+  std::ifstream in(json);
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["rows"].size(), 2u);
   std::filesystem::remove(json);
 }
 
