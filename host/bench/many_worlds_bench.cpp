@@ -354,7 +354,7 @@ std::string manyWorldsTable(const nlohmann::json& j) {
   std::string t = fmt::format(
       "\nMany worlds: {} worlds of n boxes each, all moving, every world's pairs validated; ms a frame for all "
       "worlds, median over {} frames, and the cpu backend's time over it (x); accelerator rows: measured host + "
-      "MODELLED device and link on the named profile\n{:<44}",
+      "MODELLED device and link on the named profile\n{:<52}",
       j["worlds"].get<std::size_t>(), j["frames"].get<std::size_t>(), "method");
   for (const auto& r : rows) t += fmt::format("{:>22}", fmt::format("n={}", r["boxes_per_world"].get<std::size_t>()));
   t += "\n";
@@ -363,7 +363,7 @@ std::string manyWorldsTable(const nlohmann::json& j) {
     for (const auto& m : r["methods"])
       if (std::find(names.begin(), names.end(), m["name"]) == names.end()) names.push_back(m["name"]);
   for (const auto& name : names) {
-    t += fmt::format("{:<44}", name);
+    t += fmt::format("{:<52}", name);
     for (const auto& r : rows) {
       const nlohmann::json* mine = nullptr;
       double cpu = 0;
