@@ -122,7 +122,7 @@ bench-run: host
 # of every method still validated, a few frames a row. Methods whose set-up or
 # sweep cannot be stopped midway are skipped with their reason where they would
 # take many minutes (docs/results.md); --max-method-seconds stops the others.
-BENCH_LARGE_ARGS ?= --objects 100000 1000000 --backend model --frames 3 --warmup 1 --whole-step-objects 0
+BENCH_LARGE_ARGS ?= --objects 100000 1000000 --backend model --frames 3 --warmup 1 --whole-step-objects 0 --many-worlds 0
 .PHONY: bench-large bench-run bench-large-run
 bench-large: deps
 	$(MAKE) bench-large-run ARCH=$(BENCH_ARCH) M=$(BENCH_M) HOST_BIN_DIR=$(BENCH_BIN_DIR)

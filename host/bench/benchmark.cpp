@@ -29,19 +29,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// first_tenth and last_tenth: the medians of the first and of the last
-// tenth of the frames, in order (at least one frame each), so a method that
-// slows down or speeds up over a run shows it beside its median.
-nlohmann::json summary(const std::vector<double>& v, double scale) {
-  if (v.empty()) return nullptr;
-  const auto tenth = static_cast<std::ptrdiff_t>(std::max<std::size_t>(1, v.size() / 10));
-  return {{"median", median(v) * scale},
-          {"min", *std::min_element(v.begin(), v.end()) * scale},
-          {"max", *std::max_element(v.begin(), v.end()) * scale},
-          {"first_tenth", median(std::vector<double>(v.begin(), v.begin() + tenth)) * scale},
-          {"last_tenth", median(std::vector<double>(v.end() - tenth, v.end())) * scale}};
-}
-
 std::string machineDescription() {
   std::ifstream cpuinfo("/proc/cpuinfo");
   std::string line;
@@ -68,7 +55,39 @@ struct Entry {
 
 bool isBaseline(MethodKind k) { return k == MethodKind::Bullet || k == MethodKind::Peer; }
 
+// Each "X, T threads" row of the cpu backend beside its one-thread row "X":
+// the speedup of T threads over one, and that divided by T (1 = every core fully used).
+void addParallelEfficiency(nlohmann::json& methods) {
+  for (auto& m : methods) {
+    const std::string name = m["name"];
+    const auto comma = name.rfind(", ");
+    if (m["kind"] != "cpu" || comma == std::string::npos || !name.ends_with(" threads") || !m["frame_ms"].is_object())
+      continue;
+    const std::size_t threads = std::stoul(name.substr(comma + 2));
+    for (const auto& one : methods)
+      if (one["name"] == name.substr(0, comma) && one["frame_ms"].is_object()) {
+        const double speedup = one["frame_ms"]["median"].get<double>() / m["frame_ms"]["median"].get<double>();
+        m["threads"] = threads;
+        m["speedup_over_one_thread"] = speedup;
+        m["parallel_efficiency"] = speedup / static_cast<double>(threads);
+      }
+  }
+}
+
 }  // namespace
+
+// first_tenth and last_tenth: the medians of the first and of the last
+// tenth of the frames, in order (at least one frame each), so a method that
+// slows down or speeds up over a run shows it beside its median.
+nlohmann::json summary(const std::vector<double>& v, double scale) {
+  if (v.empty()) return nullptr;
+  const auto tenth = static_cast<std::ptrdiff_t>(std::max<std::size_t>(1, v.size() / 10));
+  return {{"median", median(v) * scale},
+          {"min", *std::min_element(v.begin(), v.end()) * scale},
+          {"max", *std::max_element(v.begin(), v.end()) * scale},
+          {"first_tenth", median(std::vector<double>(v.begin(), v.begin() + tenth)) * scale},
+          {"last_tenth", median(std::vector<double>(v.end() - tenth, v.end())) * scale}};
+}
 
 ValidationFailure::ValidationFailure(std::string method, std::size_t objects, std::size_t frame, SetDifference d,
                                      std::size_t exactPairs)
@@ -115,6 +134,7 @@ std::vector<MethodSpec> standardLineUp(const LineUpConfig& config) {
   if (config.cpuThreads > 1)
     for (auto& s : threadedCpuMethods(config.cellSizes, config.cpuThreads)) specs.push_back(std::move(s));
   for (auto& s : automaticCpuMethods(config.cpuThreads)) specs.push_back(std::move(s));
+  specs.push_back(bpaccelFclMethod());
   return specs;
 }
 
@@ -197,6 +217,11 @@ nlohmann::json Benchmark::run() {
     queries.scene = config_.scene;
     out["queries"] = runQueryBench(queries, progress_);
   }
+  if (config_.manyWorlds.worlds) {
+    ManyWorldsBenchConfig worlds = config_.manyWorlds;
+    worlds.scene = config_.scene;
+    out["many_worlds"] = runManyWorldsBench(worlds, manyWorldsLineUp(worlds.device), progress_);
+  }
   out["validation"] = "every frame of every method compared with the exact set: accelerator and cpu equal to it (a "
                       "difference stops the run); Bullet and peers counted (extra allowed, missing reported)";
   return out;
@@ -236,31 +261,49 @@ nlohmann::json timelineJson(const std::vector<Entry>& entries, std::size_t objec
 }  // namespace
 
 // A simulation's whole step, not just its broad phase: what a user of the
-// world would see. Each world starts from the same seed; both are measured.
+// world would see, with a game's broad-phase ray tests after each step. Each
+// world starts from the same seed; both are measured.
 nlohmann::json Benchmark::wholeSteps() {
   SceneConfig sc = config_.scene;
   sc.objects = config_.wholeStepObjects;
-  const std::size_t warmup = 3, frames = config_.wholeStepFrames;
+  const WholeStepConfig steps{.frames = config_.wholeStepFrames, .warmup = 3, .rays = config_.wholeStepRays};
   constexpr std::size_t kCell = 64;
   struct Candidate {
     std::string name;
     BtBroadphaseFactory make;
+    bool exact;  // its rays must report exactly the proxies Bullet's ray-box test accepts
   };
   const std::vector<Candidate> candidates = {
-      {"btDbvtBroadphase", [] { return std::make_unique<btDbvtBroadphase>(); }},
+      {"btDbvtBroadphase", [] { return std::make_unique<btDbvtBroadphase>(); }, false},
       {fmt::format("bpaccel::BulletDropIn, cpu backend, k-d {}", kCell),
-       [] { return std::make_unique<BulletDropIn>(std::make_unique<CpuBackend>(), BulletDropInOptions{kCell}); }}};
+       [] { return std::make_unique<BulletDropIn>(std::make_unique<CpuBackend>(), BulletDropInOptions{kCell}); },
+       true}};
   nlohmann::json methods = nlohmann::json::array();
   for (const auto& c : candidates) {
     progress_(fmt::format("whole step, n={}: {}", sc.objects, c.name));
-    const StepTimes t = timeWholeSteps(sc, c.make, frames, warmup);
-    methods.push_back({{"name", c.name}, {"step_ms", summary(t.stepSeconds, 1e3)}});
+    const StepTimes t = timeWholeSteps(sc, c.make, steps);
+    nlohmann::json m = {{"name", c.name}, {"step_ms", summary(t.stepSeconds, 1e3)}};
+    if (steps.rays) {
+      if (c.exact && (t.rayMissing || t.rayExtra))
+        throw std::runtime_error(fmt::format("whole step: {}'s ray tests gave {} missing and {} extra proxies", c.name,
+                                             t.rayMissing, t.rayExtra));
+      std::vector<double> frame(t.stepSeconds.size());
+      for (std::size_t f = 0; f < frame.size(); ++f) frame[f] = t.stepSeconds[f] + t.raySeconds[f];
+      m["rays_ms"] = summary(t.raySeconds, 1e3);
+      m["step_and_rays_ms"] = summary(frame, 1e3);
+      m["ray_proxies"] = {{"reported", t.rayHits}, {"extra", t.rayExtra}, {"missing", t.rayMissing}};
+    }
+    methods.push_back(m);
   }
   return {{"objects", sc.objects},
-          {"frames", frames},
-          {"warmup_frames", warmup},
+          {"frames", steps.frames},
+          {"warmup_frames", steps.warmup},
+          {"rays_per_frame", steps.rays},
           {"what", "measured: full btDiscreteDynamicsWorld::stepSimulation (broad phase, pair cache updates, narrow "
-                   "phase, solver) of the bouncing cube, one world per broad phase from the same seed"},
+                   "phase, solver) of the bouncing cube, one world per broad phase from the same seed; then "
+                   "rays_per_frame broad-phase rayTests (random segments in the cube, 1 to an edge long), each "
+                   "ray's proxies checked against Bullet's ray-box test on every proxy's box (extra: btDbvtBroadphase's "
+                   "padded leaves)"},
           {"methods", methods}};
 }
 
@@ -503,6 +546,7 @@ nlohmann::json Benchmark::runRow(SceneFamily family, std::size_t objects) {
     j["acceleration_over_fastest_baseline"] = fastest ? nlohmann::json(median(fastest->frameSeconds) / mine) : nullptr;
     methods.push_back(j);
   }
+  addParallelEfficiency(methods);
   row["methods"] = methods;
   row["timeline"] = timelineJson(entries, objects);
 
@@ -529,6 +573,77 @@ const nlohmann::json* findMethod(const nlohmann::json& row, const std::string& n
   return nullptr;
 }
 
+// The cpu backend's rows on several threads: speedup over one thread, and per thread.
+std::string parallelTable(const nlohmann::json& rows, const std::vector<std::string>& names, std::size_t nameWidth) {
+  std::string body;
+  for (const auto& name : names) {
+    std::string line;
+    bool any = false;
+    for (const auto& r : rows) {
+      const auto* m = findMethod(r, name);
+      any = any || (m && m->contains("parallel_efficiency"));
+      line += m && m->contains("parallel_efficiency")
+                  ? fmt::format("{:>16}", fmt::format("{:.2f}x {:.2f}", (*m)["speedup_over_one_thread"].get<double>(),
+                                                      (*m)["parallel_efficiency"].get<double>()))
+                  : fmt::format("{:>16}", "-");
+    }
+    if (any) body += pad(name, nameWidth) + line + "\n";
+  }
+  if (body.empty()) return body;
+  std::string t = "\nParallel efficiency of the cpu backend: speedup of T threads over the same row on one thread, "
+                  "and that speedup / T (measured in this run)\n" + pad("method", nameWidth);
+  for (const auto& r : rows) t += fmt::format("{:>16}", fmt::format("n={}", r["objects"].get<std::size_t>()));
+  return t + "\n" + body;
+}
+
+// The whole steps, and with rays the step plus its ray tests.
+std::string wholeStepTable(const nlohmann::json& w) {
+  const std::size_t rays = w.value("rays_per_frame", std::size_t{0});
+  std::string t = fmt::format("\nWhole stepSimulation of the bouncing cube, n={}, median of {} frames, ms (measured; the "
+                              "broad phase is only part of a step){}:\n",
+                              w["objects"].get<std::size_t>(), w["frames"].get<std::size_t>(),
+                              rays ? fmt::format("; then {} broad-phase ray tests, every answer checked", rays) : "");
+  if (rays) t += fmt::format("  {} {:>12} {:>12} {:>14}\n", pad("", 44), "step", "rays", "step + rays");
+  const auto first = w["methods"][0];
+  const char* key = rays ? "step_and_rays_ms" : "step_ms";
+  for (const auto& m : w["methods"]) {
+    const double whole = m[key]["median"].get<double>();
+    t += fmt::format("  {} {:>12.3f}", pad(m["name"], 44), m["step_ms"]["median"].get<double>());
+    if (rays)
+      t += fmt::format(" {:>12.3f} {:>14.3f}   (ray proxies: extra {}, missing {})", m["rays_ms"]["median"].get<double>(),
+                       whole, m["ray_proxies"]["extra"].get<std::uint64_t>(),
+                       m["ray_proxies"]["missing"].get<std::uint64_t>());
+    t += fmt::format("   {:.2f}x\n", first[key]["median"].get<double>() / whole);
+  }
+  return t;
+}
+
+// Bullet's and the peers' first and last tenth of frames beside the median:
+// a broad phase whose structure decays over a run shows it here.
+std::string tenthsTable(const nlohmann::json& rows, const std::vector<std::string>& names, std::size_t nameWidth) {
+  std::string t = "\nBullet and the peers over the run: median of the first tenth of the timed frames / median of "
+                  "all / median of the last tenth, ms\n" + pad("method", nameWidth);
+  for (const auto& r : rows) t += fmt::format("{:>28}", fmt::format("n={}", r["objects"].get<std::size_t>()));
+  t += "\n";
+  for (const auto& name : names) {
+    std::string line;
+    bool baseline = false;
+    for (const auto& r : rows) {
+      const auto* m = findMethod(r, name);
+      baseline = baseline || (m && ((*m)["kind"] == "bullet" || (*m)["kind"] == "peer"));
+      if (!m || m->contains("skipped") || !(*m)["frame_ms"].is_object()) {
+        line += fmt::format("{:>28}", "-");
+        continue;
+      }
+      const auto& f = (*m)["frame_ms"];
+      line += fmt::format("{:>28}", fmt::format("{:.3f} / {:.3f} / {:.3f}", f["first_tenth"].get<double>(),
+                                                f["median"].get<double>(), f["last_tenth"].get<double>()));
+    }
+    if (baseline) t += pad(name, nameWidth) + line + "\n";
+  }
+  return t;
+}
+
 }  // namespace
 
 std::string Benchmark::table(const nlohmann::json& results) {
@@ -552,7 +667,7 @@ std::string Benchmark::table(const nlohmann::json& results) {
     return t;
   }
   const auto& cfg = results["configuration"];
-  constexpr std::size_t kName = 34;  // "accelerator grid 128 on ecp5-5g"
+  constexpr std::size_t kName = 40;  // "bpaccel::BroadPhaseManager, cpu grid 64"
   std::vector<std::string> names;  // every method of any row, in line-up order
   for (const auto& r : rows)
     for (const auto& m : r["methods"])
@@ -677,6 +792,8 @@ std::string Benchmark::table(const nlohmann::json& results) {
       t += "\n";
     }
   };
+  t += tenthsTable(rows, names, kName);
+  t += parallelTable(rows, names, kName);
   accelerationBlock("Acceleration over the FASTEST of Bullet and the peers in the same run (of those that found "
                     "every pair; named per column)",
                     [](const nlohmann::json& r) { return r["fastest_baseline"]; });
@@ -733,17 +850,9 @@ std::string Benchmark::table(const nlohmann::json& results) {
                      slowest, slowestSetup, sum(ts["method_updates"]), sum(ts["method_teardown"]));
   }
   t += "\n";
-  if (results.contains("whole_step") && results["whole_step"].is_object()) {
-    const auto& w = results["whole_step"];
-    t += fmt::format("\nWhole stepSimulation of the bouncing cube, n={}, median of {} frames, ms (measured; the broad "
-                     "phase is only part of a step):\n",
-                     w["objects"].get<std::size_t>(), w["frames"].get<std::size_t>());
-    const double first = w["methods"][0]["step_ms"]["median"].get<double>();
-    for (const auto& m : w["methods"])
-      t += fmt::format("  {} {:>12.3f}   {:.2f}x\n", pad(m["name"], 44), m["step_ms"]["median"].get<double>(),
-                       first / m["step_ms"]["median"].get<double>());
-  }
+  if (results.contains("whole_step") && results["whole_step"].is_object()) t += wholeStepTable(results["whole_step"]);
   if (results.contains("queries")) t += queryTable(results["queries"]);
+  if (results.contains("many_worlds")) t += manyWorldsTable(results["many_worlds"]);
   return t;
 }
 

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "methods/accelerator_method.hpp"
+#include "many_worlds_bench.hpp"
 #include "query_bench.hpp"
 #include "scene.hpp"
 #include "scene_families.hpp"
@@ -39,6 +40,8 @@ struct BenchConfig {
   std::size_t wholeStepRays = 0;
   /// Ray and box queries (query_bench.hpp) at these object counts; empty: none.
   QueryBenchConfig queries;
+  /// Many small worlds (many_worlds_bench.hpp; its scene is set from `scene`); worlds 0: none.
+  ManyWorldsBenchConfig manyWorlds;
 };
 
 /// What the standard line-up holds.
@@ -87,6 +90,10 @@ class Benchmark {
   nlohmann::json configuration_;
   Progress progress_;
 };
+
+/// Samples `v` times `scale`: median, min, max, and the medians of the first
+/// and of the last tenth (at least one sample each), in order; null when empty.
+nlohmann::json summary(const std::vector<double>& v, double scale);
 
 /// Pairs of `got` not in `exact` (extra) and of `exact` not in `got` (missing); both sorted.
 struct SetDifference {

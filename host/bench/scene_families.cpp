@@ -235,16 +235,21 @@ void KinematicScene::step() {
   }
 }
 
+std::array<float, 3> turnedHalfExtents(const std::array<float, 3>& half, int spinAxis, float angle) {
+  const int s = spinAxis, i = (s + 1) % 3, j = (s + 2) % 3;
+  const float cs = std::abs(std::cos(angle)), sn = std::abs(std::sin(angle));
+  std::array<float, 3> h{};
+  h[s] = half[s];
+  h[i] = cs * half[i] + sn * half[j];
+  h[j] = sn * half[i] + cs * half[j];
+  return h;
+}
+
 void KinematicScene::aabbs(std::vector<Aabb>& out) const {
   out.resize(bodies_.size());
   for (std::size_t k = 0; k < bodies_.size(); ++k) {
     const Body& b = bodies_[k];
-    const int s = b.spinAxis, i = (s + 1) % 3, j = (s + 2) % 3;
-    const float cs = std::abs(std::cos(b.angle)), sn = std::abs(std::sin(b.angle));
-    std::array<float, 3> h{};
-    h[s] = b.half[s];
-    h[i] = cs * b.half[i] + sn * b.half[j];
-    h[j] = sn * b.half[i] + cs * b.half[j];
+    const std::array<float, 3> h = turnedHalfExtents(b.half, b.spinAxis, b.angle);
     for (int a = 0; a < 3; ++a) {
       // Clamped so that rounding cannot carry a box past the world's bounds.
       out[k].min[a] = std::max(b.centre[a] - h[a], worldLo_[a]);

@@ -51,6 +51,11 @@ std::string_view familyDescription(SceneFamily family);
 /// the rest of `cube` (sizes, density, speeds); the others use their own.
 std::unique_ptr<FrameSource> makeFrameSource(SceneFamily family, const SceneConfig& cube);
 
+/// The half extents of the AABB of a box of half extents `half` turned by
+/// `angle` radians about axis `spinAxis`: the two other axes each span |cos|
+/// of their own half extent plus |sin| of the other's.
+std::array<float, 3> turnedHalfExtents(const std::array<float, 3>& half, int spinAxis, float angle);
+
 /// The kinematic families. Every object is a box of fixed half extents that
 /// turns about one axis at its own rate (its AABB grows and shrinks on both
 /// sides, as a rotating body's does), moves at constant velocity and bounces

@@ -37,10 +37,12 @@ std::string BulletMethod::name(Kind kind) {
   return "?";
 }
 
-BulletMethod::BulletMethod(Kind kind, std::span<const Aabb> initial, float worldMin, float worldMax)
+BulletMethod::BulletMethod(Kind kind, std::span<const Aabb> initial, float worldMin, float worldMax,
+                           btCollisionDispatcher* shared)
     : kind_(kind),
-      config_(std::make_unique<btDefaultCollisionConfiguration>()),
-      dispatcher_(std::make_unique<btCollisionDispatcher>(config_.get())) {
+      config_(shared ? nullptr : std::make_unique<btDefaultCollisionConfiguration>()),
+      ownDispatcher_(shared ? nullptr : std::make_unique<btCollisionDispatcher>(config_.get())),
+      dispatcher_(shared ? shared : ownDispatcher_.get()) {
   const std::size_t count = initial.size();
   switch (kind) {
     case Kind::Dbvt: broadphase_ = std::make_unique<btDbvtBroadphase>(); break;
@@ -66,8 +68,8 @@ BulletMethod::BulletMethod(Kind kind, std::span<const Aabb> initial, float world
                                            // index + 1: btSimpleBroadphase skips proxies whose client object is null
                                            reinterpret_cast<void*>(static_cast<std::uintptr_t>(i) + 1),
                                            btBroadphaseProxy::DefaultFilter, btBroadphaseProxy::AllFilter,
-                                           dispatcher_.get());
-  broadphase_->calculateOverlappingPairs(dispatcher_.get());
+                                           dispatcher_);
+  broadphase_->calculateOverlappingPairs(dispatcher_);
 }
 
 // btDbvtBroadphase allocates every proxy and frees it only in destroyProxy
@@ -79,15 +81,15 @@ BulletMethod::BulletMethod(Kind kind, std::span<const Aabb> initial, float world
 // pair holds a collision algorithm: nothing was dispatched.
 BulletMethod::~BulletMethod() {
   if (kind_ != Kind::Dbvt) return;
-  removeAllOverlappingPairs(*broadphase_->getOverlappingPairCache(), dispatcher_.get());
-  for (btBroadphaseProxy* p : proxies_) broadphase_->destroyProxy(p, dispatcher_.get());
+  removeAllOverlappingPairs(*broadphase_->getOverlappingPairCache(), dispatcher_);
+  for (btBroadphaseProxy* p : proxies_) broadphase_->destroyProxy(p, dispatcher_);
 }
 
 void BulletMethod::update(std::span<const Aabb> boxes) {
   if (boxes.size() != proxies_.size()) throw std::invalid_argument("bullet broadphase: object count changed");
   for (std::size_t i = 0; i < boxes.size(); ++i)
-    broadphase_->setAabb(proxies_[i], lo(boxes[i]), hi(boxes[i]), dispatcher_.get());
-  broadphase_->calculateOverlappingPairs(dispatcher_.get());
+    broadphase_->setAabb(proxies_[i], lo(boxes[i]), hi(boxes[i]), dispatcher_);
+  broadphase_->calculateOverlappingPairs(dispatcher_);
 }
 
 void BulletMethod::pairs(std::vector<Pair>& out) {

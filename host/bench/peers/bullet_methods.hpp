@@ -22,7 +22,10 @@ class BulletMethod final : public TimedMethod {
   static std::string name(Kind kind);
 
   /// Creates one proxy per box. `worldMin`/`worldMax` bound the sweep-and-prune's quantisation.
-  BulletMethod(Kind kind, std::span<const Aabb> initial, float worldMin, float worldMax);
+  /// With `shared`, its pairs go through that dispatcher (which must outlive
+  /// it), as many small worlds share one; else through a dispatcher of its own.
+  BulletMethod(Kind kind, std::span<const Aabb> initial, float worldMin, float worldMax,
+               btCollisionDispatcher* shared = nullptr);
   ~BulletMethod() override;
   BulletMethod(const BulletMethod&) = delete;
   BulletMethod& operator=(const BulletMethod&) = delete;
@@ -36,7 +39,8 @@ class BulletMethod final : public TimedMethod {
  private:
   Kind kind_;
   std::unique_ptr<btDefaultCollisionConfiguration> config_;
-  std::unique_ptr<btCollisionDispatcher> dispatcher_;
+  std::unique_ptr<btCollisionDispatcher> ownDispatcher_;
+  btCollisionDispatcher* dispatcher_;  // ownDispatcher_ or a shared one
   std::unique_ptr<btBroadphaseInterface> broadphase_;
   std::vector<btBroadphaseProxy*> proxies_;  // index = object
 };

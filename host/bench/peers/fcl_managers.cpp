@@ -8,6 +8,10 @@
 #include <fcl/broadphase/broadphase_spatialhash.h>
 #include <fcl/broadphase/detail/sparse_hash_table.h>
 #include <fcl/geometry/shape/box.h>
+#include <fmt/format.h>
+
+#include "device/cpu_backend.hpp"
+#include "fcl/broad_phase_manager.hpp"
 
 namespace bpaccel {
 namespace {
@@ -42,10 +46,12 @@ struct FclManager::Impl {
   std::vector<std::unique_ptr<AabbObject>> objects;
   std::vector<fcl::CollisionObjectd*> raw;  // the same objects, as the manager takes them
   std::unique_ptr<fcl::BroadPhaseCollisionManagerd> manager;
-  bool rebuild = false;
+  Usage usage = Usage::UpdateAll;
 };
 
-FclManager::FclManager(Kind kind, const SceneStart& start) : impl_(std::make_unique<Impl>()) {
+FclManager::FclManager(Kind kind, Usage usage, const SceneStart& start, std::size_t bpaccelCellSize)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->usage = usage;
   switch (kind) {
     case Kind::DynamicAabbTree:
       impl_->manager = std::make_unique<fcl::DynamicAABBTreeCollisionManagerd>();
@@ -57,7 +63,12 @@ FclManager::FclManager(Kind kind, const SceneStart& start) : impl_(std::make_uni
       // lists and crashes. So it is rebuilt every frame: registerObjects sorts
       // the end points and sweeps, which is the manager's batch use.
       impl_->manager = std::make_unique<fcl::SaPCollisionManagerd>();
-      impl_->rebuild = true;
+      impl_->usage = Usage::Rebuild;
+      break;
+    case Kind::Bpaccel:
+      impl_->manager = std::make_unique<BroadPhaseManagerd>(
+          std::make_unique<CpuBackend>(),
+          BroadPhaseManagerOptions{.cellSize = bpaccelCellSize, .partition = PartitionKind::UniformGrid});
       break;
     case Kind::SpatialHashing: {
       // Cells as large as the largest box, so a box touches at most 8 cells
@@ -91,35 +102,58 @@ FclManager::~FclManager() = default;
 void FclManager::update(std::span<const Aabb> boxes) {
   if (boxes.size() != impl_->objects.size()) throw std::invalid_argument("fcl: object count changed");
   for (std::size_t i = 0; i < boxes.size(); ++i) impl_->objects[i]->setAabb(boxes[i]);
-  if (impl_->rebuild) {
-    impl_->manager->clear();
-    impl_->manager->registerObjects(impl_->raw);
-    impl_->manager->setup();
-  } else {
-    impl_->manager->update();
+  switch (impl_->usage) {
+    case Usage::UpdateAll: impl_->manager->update(); break;
+    case Usage::UpdateEach: impl_->manager->update(impl_->raw); break;
+    case Usage::Rebuild:
+      impl_->manager->clear();
+      impl_->manager->registerObjects(impl_->raw);
+      impl_->manager->setup();
+      break;
   }
   pairs_.clear();
   impl_->manager->collide(&pairs_, recordPair);
 }
 
+namespace {
+
+MethodSpec fclSpec(std::string name, FclManager::Kind kind, FclManager::Usage usage) {
+  MethodSpec s;
+  s.name = std::move(name);
+  s.kind = MethodKind::Peer;
+  s.library = "FCL 0.7";
+  s.make = [kind, usage](const SceneStart& start) { return std::make_unique<FclManager>(kind, usage, start); };
+  return s;
+}
+
+}  // namespace
+
 std::vector<MethodSpec> fclMethods(double maxSweepTests) {
-  std::vector<MethodSpec> specs;
-  const std::pair<FclManager::Kind, const char*> kinds[] = {
-      {FclManager::Kind::DynamicAabbTree, "FCL DynamicAABBTree"},
-      {FclManager::Kind::SweepAndPrune, "FCL SaP (rebuilt)"},
-      {FclManager::Kind::SpatialHashing, "FCL SpatialHashing"}};
-  for (const auto& [kind, name] : kinds) {
-    MethodSpec s;
-    s.name = name;
-    s.kind = MethodKind::Peer;
-    s.library = "FCL 0.7";
-    // Its set-up and every frame are one registerObjects: a sweep that
-    // max-method-seconds cannot stop midway.
-    if (kind == FclManager::Kind::SweepAndPrune) s.skipReason = sweepSkipReason(maxSweepTests);
-    s.make = [kind](const SceneStart& start) { return std::make_unique<FclManager>(kind, start); };
-    specs.push_back(std::move(s));
-  }
+  using K = FclManager::Kind;
+  using U = FclManager::Usage;
+  std::vector<MethodSpec> specs = {
+      fclSpec("FCL DynamicAABBTree", K::DynamicAabbTree, U::UpdateAll),
+      fclSpec("FCL DynamicAABBTree, update(objects)", K::DynamicAabbTree, U::UpdateEach),
+      fclSpec("FCL DynamicAABBTree, rebuilt", K::DynamicAabbTree, U::Rebuild),
+      fclSpec("FCL SaP (rebuilt)", K::SweepAndPrune, U::Rebuild),
+      fclSpec("FCL SpatialHashing", K::SpatialHashing, U::UpdateAll)};
+  // Its set-up and every frame are one registerObjects: a sweep that
+  // max-method-seconds cannot stop midway.
+  specs[3].skipReason = sweepSkipReason(maxSweepTests);
   return specs;
+}
+
+MethodSpec bpaccelFclMethod(std::size_t cellSize) {
+  MethodSpec s = fclSpec(fmt::format("bpaccel::BroadPhaseManager, cpu grid {}", cellSize), FclManager::Kind::Bpaccel,
+                         FclManager::Usage::UpdateAll);
+  s.kind = MethodKind::Cpu;
+  s.library = "bpaccel";
+  s.cellSize = cellSize;
+  s.partition = partitionName(PartitionKind::UniformGrid);
+  s.make = [cellSize](const SceneStart& start) {
+    return std::make_unique<FclManager>(FclManager::Kind::Bpaccel, FclManager::Usage::UpdateAll, start, cellSize);
+  };
+  return s;
 }
 
 }  // namespace bpaccel

@@ -2,12 +2,14 @@
 // accelerator and the cpu backend), and the scene it runs on, for rendering.
 //
 //   bpaccel-bench run [--objects N ...] [--json FILE] ...   (see --help)
+//   bpaccel-bench worlds [--worlds W] [--world-sizes N ...] [--json FILE]   (many small worlds)
 //   bpaccel-bench scene [--objects N] [--frames F] [--out FILE]
 //   bpaccel-bench boxes [--family F] [--objects N] [--frame K] [--out FILE]
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -76,6 +78,22 @@ std::vector<bpaccel::DeviceProfile> makeProfiles(const ProfileOptions& o) {
   return profiles;
 }
 
+// The results of `run`, written to `jsonPath`; none, with the failure on
+// stderr, when an exact method's answer was wrong.
+std::optional<nlohmann::json> validatedRun(const std::function<nlohmann::json()>& run, const std::string& jsonPath) {
+  nlohmann::json results;
+  try {
+    results = run();
+  } catch (const bpaccel::ValidationFailure& e) {
+    fmt::print(stderr, "bench: VALIDATION FAILED: {}\n", e.what());
+    return std::nullopt;
+  }
+  const std::filesystem::path path(jsonPath);
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  std::ofstream(path) << results.dump(2) << "\n";
+  return results;
+}
+
 int runBench(const bpaccel::BenchConfig& config, bpaccel::LineUpConfig lineUp, const std::vector<std::string>& cells,
              const std::string& jsonPath) {
   lineUp.cellSizes.clear();
@@ -83,24 +101,32 @@ int runBench(const bpaccel::BenchConfig& config, bpaccel::LineUpConfig lineUp, c
   for (const auto& p : lineUp.profiles) fmt::print(stderr, "bench: profile {}\n", p.summary());
   bpaccel::Benchmark bench(config, bpaccel::standardLineUp(lineUp), bpaccel::describe(lineUp),
                            [](const std::string& line) { fmt::print(stderr, "bench: {}\n", line); });
-  nlohmann::json results;
-  try {
-    results = bench.run();
-  } catch (const bpaccel::ValidationFailure& e) {
-    fmt::print(stderr, "bench: VALIDATION FAILED: {}\n", e.what());
-    return 3;
-  }
-  const std::filesystem::path path(jsonPath);
-  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
-  std::ofstream(path) << results.dump(2) << "\n";
-  fmt::print("{}", bpaccel::Benchmark::table(results));
+  const auto results = validatedRun([&] { return bench.run(); }, jsonPath);
+  if (!results) return 3;
+  fmt::print("{}", bpaccel::Benchmark::table(*results));
   fmt::print("\nAll frames validated. Results: {}\n", jsonPath);
-  for (const auto& r : results["rows"])
+  for (const auto& r : (*results)["rows"])
     for (const auto& m : r["methods"])
       if (m["missing_pairs"].is_number() && m["missing_pairs"].get<std::uint64_t>() > 0)
         fmt::print(stderr, "bench: FINDING: {} missed {} exact pairs at n = {} (marked in the table)\n",
                    m["name"].get<std::string>(), m["missing_pairs"].get<std::uint64_t>(),
                    r["objects"].get<std::size_t>());
+  return 0;
+}
+
+int runWorlds(const bpaccel::BenchConfig& config, const std::string& jsonPath) {
+  bpaccel::ManyWorldsBenchConfig worlds = config.manyWorlds;
+  worlds.scene = config.scene;
+  for (const auto& p : worlds.profiles) fmt::print(stderr, "bench: profile {}\n", p.summary());
+  const auto results = validatedRun(
+      [&] {
+        return bpaccel::runManyWorldsBench(worlds, bpaccel::manyWorldsLineUp(worlds.device), [](const std::string& line) {
+          fmt::print(stderr, "bench: {}\n", line);
+        });
+      },
+      jsonPath);
+  if (!results) return 3;
+  fmt::print("{}\nEvery world of every frame validated. Results: {}\n", bpaccel::manyWorldsTable(*results), jsonPath);
   return 0;
 }
 
@@ -146,7 +172,9 @@ int main(int argc, char** argv) {
 
   bpaccel::BenchConfig bench;
   bench.wholeStepObjects = 8000;
+  bench.wholeStepRays = 500;
   bench.queries.objectCounts = {8000, 100000};
+  bench.manyWorlds.worlds = 4096;
   bpaccel::LineUpConfig lineUp;
   lineUp.cpuThreads = std::thread::hardware_concurrency();
   std::vector<std::string> benchCells = {"none", "16", "32", "64", "128", "256"};
@@ -229,12 +257,28 @@ int main(int argc, char** argv) {
                        "Also time full stepSimulation calls with btDbvtBroadphase and bpaccel::BulletDropIn at this "
                        "object count (0: not)")
       ->capture_default_str();
+  benchCmd->add_option("--whole-step-rays", bench.wholeStepRays,
+                       "Broad-phase rayTests cast after each timed whole step, timed and every answer checked (0: none)")
+      ->capture_default_str();
   benchCmd->add_option("--query-objects", bench.queries.objectCounts,
                        "Also time broad-phase rayTest and aabbTest, btDbvtBroadphase against bpaccel::BulletDropIn, "
                        "at these object counts (none: not)")
       ->capture_default_str();
   benchCmd->add_option("--query-count", bench.queries.perKind, "Queries of each kind (two ray lengths, boxes) a round of the query table")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  const auto addWorldsOptions = [](CLI::App* cmd, bpaccel::ManyWorldsBenchConfig& w) {
+    cmd->add_option("--world-sizes", w.boxesPerWorld, "Boxes per world of the many-worlds table, one column each")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    cmd->add_option("--world-frames", w.frames, "Timed frames of the many-worlds table")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    cmd->add_option("--world-warmup", w.warmup, "Untimed frames before them")->capture_default_str();
+  };
+  benchCmd->add_option("--many-worlds", bench.manyWorlds.worlds,
+                       "Also run the many-worlds table: this many independent worlds a frame, found by the cpu "
+                       "backend through ManyWorlds, by btDbvtBroadphase and FCL's tree one per world, and by the "
+                       "accelerator through ManyWorlds, modelled per profile (0: not)")
+      ->capture_default_str();
+  addWorldsOptions(benchCmd, bench.manyWorlds);
   benchCmd->add_option("--cpu-threads", lineUp.cpuThreads,
                        "Threads of the extra 'cpu k-d C, T threads' rows (default: every hardware thread; 0 or 1: none)")
       ->capture_default_str();
@@ -270,6 +314,26 @@ int main(int argc, char** argv) {
   boxesCmd->add_option("--out", boxesOut, "Output box file")->capture_default_str();
   addSceneOptions(boxesCmd, boxesConfig);
 
+  bpaccel::BenchConfig worlds;
+  worlds.manyWorlds.worlds = 4096;
+  worlds.manyWorlds.frames = 20;
+  worlds.manyWorlds.warmup = 2;
+  std::string worldsBackend = "rtl", worldsJson = "results/many_worlds.json";
+  bool worldsAccelerator = true;
+  auto* worldsCmd = app.add_subcommand(
+      "worlds", "The many-worlds table alone: W small worlds a frame, every world's pairs validated");
+  worldsCmd->add_option("--worlds", worlds.manyWorlds.worlds, "Worlds a frame")->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  addWorldsOptions(worldsCmd, worlds.manyWorlds);
+  worldsCmd->add_flag("--accelerator,!--no-accelerator", worldsAccelerator, "Run the accelerator's rows")
+      ->capture_default_str();
+  worldsCmd->add_option("--backend", worldsBackend, "Where device cycles come from: rtl (Verilated) or model")
+      ->check(CLI::IsMember({"rtl", "model"}))->capture_default_str();
+  worldsCmd->add_option("--profiles", profileOptions.names, "Platforms the accelerator rows are modelled on (as run's)")
+      ->check(CLI::IsMember({"ecp5-5g", "gen3x8", "custom"}))->capture_default_str();
+  worldsCmd->add_option("--json", worldsJson, "Where to write every figure")->capture_default_str();
+  addSceneOptions(worldsCmd, worlds.scene);
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (*benchCmd) {
@@ -278,8 +342,17 @@ int main(int argc, char** argv) {
       if (accelerator) {
         lineUp.device = makeDevice(benchBackend, cellsPerBatch, firstBatchCells, paced);
         lineUp.profiles = makeProfiles(profileOptions);
+        bench.manyWorlds.device = lineUp.device;
+        bench.manyWorlds.profiles = lineUp.profiles;
       }
       return runBench(bench, lineUp, benchCells, benchJson);
+    }
+    if (*worldsCmd) {
+      if (worldsAccelerator) {
+        worlds.manyWorlds.device = makeDevice(worldsBackend, cellsPerBatch, firstBatchCells, false);
+        worlds.manyWorlds.profiles = makeProfiles(profileOptions);
+      }
+      return runWorlds(worlds, worldsJson);
     }
     if (*boxesCmd) return runBoxes(boxesConfig, boxesFamily, boxesFrame, boxesOut);
     return runScene(sceneConfig, sceneFrames, sceneOut);

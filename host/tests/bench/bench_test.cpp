@@ -10,18 +10,24 @@
 #include <random>
 #include <set>
 #include <sys/wait.h>
+#include <utility>
 
 #include "device/model_backend.hpp"
 #include "device/built_device.hpp"
 #include "device/backend.hpp"
 #include "benchmark.hpp"
+#include "rtl_device.hpp"
 #include "bpaccel_params.h"
 #include "peers/bullet_methods.hpp"
 #include "exact_pairs.hpp"
+#include "peers/fcl_managers.hpp"
 #include "peers/ode_spaces.hpp"
 #include "device/rtl/rtl_backend.hpp"
 #include "scene.hpp"
 #include "scenes.hpp"
+#include "step_timing.hpp"
+
+#include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
 
 using namespace bpaccel;
 
@@ -33,15 +39,6 @@ BenchConfig tinyConfig() {
   c.frames = 3;
   c.warmup = 1;
   return c;
-}
-
-std::shared_ptr<DeviceConfig> rtlDevice() {
-  auto d = std::make_shared<DeviceConfig>();
-  d->backend = "rtl";
-  d->makeBackend = [] { return std::make_unique<RtlBackend>(); };
-  d->link.bytesPerBeat = 4;
-  d->hardware = {{"m", BPACCEL_M}, {"capacity", BPACCEL_CAPACITY}};
-  return d;
 }
 
 LineUpConfig tinyLineUp() {
@@ -210,12 +207,14 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
   for (const auto& row : j["rows"]) {
     EXPECT_TRUE(row.contains("exact_pairs_per_frame_mean"));
     EXPECT_FALSE(row["fastest_baseline"].is_null());
-    // Bullet 3, FCL 3, CGAL 1, ODE 2, then accelerator and cpu per cell size, k-d and grid, and cpu auto.
-    ASSERT_EQ(row["methods"].size(), 3u + 3u + 1u + 2u + (3u + 1u) + (3u + 1u) + 1u);
+    // Bullet 3, FCL 5 (the tree in three usages), CGAL 1, ODE 2, then accelerator and cpu per cell size, k-d
+    // and grid, cpu auto and bpaccel::BroadPhaseManager.
+    ASSERT_EQ(row["methods"].size(), 3u + 5u + 1u + 2u + (3u + 1u) + (3u + 1u) + 1u + 1u);
     std::set<std::string> gridRows;
     for (const auto& m : row["methods"])
       if (m.value("partition", "") == "grid") gridRows.insert(m["name"]);
-    EXPECT_EQ(gridRows, (std::set<std::string>{"accelerator grid 16", "cpu grid 16"}));
+    EXPECT_EQ(gridRows,
+              (std::set<std::string>{"accelerator grid 16", "cpu grid 16", "bpaccel::BroadPhaseManager, cpu grid 64"}));
     for (const auto& m : row["methods"]) {
       kinds.insert(m["kind"]);
       libraries.insert(m["library"]);
@@ -223,7 +222,7 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
       EXPECT_GT(m["frame_ms"]["median"].get<double>(), 0) << m["name"];
       EXPECT_TRUE(m["missing_pairs"].is_number() && m["extra_pairs"].is_number()) << m["name"];
       if (m["kind"] == "accelerator" || m["kind"] == "cpu") EXPECT_EQ(m["missing_pairs"], 0) << m["name"];
-      EXPECT_EQ(m["acceleration_over"].size(), 9u);
+      EXPECT_EQ(m["acceleration_over"].size(), 11u);
       if (m["kind"] == "accelerator")
         for (const char* part : {"host_ms_measured", "host_partition_ms_measured", "device_ms_modelled",
                                  "transfer_ms_modelled", "device_cycles",
@@ -256,8 +255,34 @@ TEST(Benchmark, RunsEveryMethodOfTheLineUpAndWritesEveryField) {
   const std::string table = Benchmark::table(j);
   for (const char* s : {"btDbvtBroadphase", "FCL DynamicAABBTree", "CGAL box_self_intersection_d", "ODE dHashSpace",
                         "accelerator k-d 16", "Acceleration over the FASTEST", "Acceleration over the fastest of FCL 0.7",
-                        "MODELLED schedule"})
+                        "MODELLED schedule", "median of the first tenth"})
     EXPECT_NE(table.find(s), std::string::npos) << s;
+}
+
+TEST(Benchmark, EveryFclUsageIsValidatedAndABrokenFclManagerOfOursFailsTheRun) {
+  LineUpConfig l;
+  auto lineUp = fclMethods(1e9);
+  lineUp.push_back(bpaccelFclMethod(16));
+  const auto j = runQuietly(tinyConfig(), lineUp, l);
+  for (const auto& row : j["rows"])
+    for (const auto& m : row["methods"]) {
+      EXPECT_EQ(m["missing_pairs"], 0) << m["name"];
+      for (const char* tenth : {"first_tenth", "last_tenth"}) EXPECT_TRUE(m["frame_ms"].contains(tenth)) << tenth;
+    }
+  auto broken = bpaccelFclMethod(16);
+  auto make = broken.make;
+  broken.make = [make](const SceneStart& s) {
+    return std::make_unique<Tampered>(make(s), [](std::vector<Pair>& p) {
+      if (!p.empty()) p.pop_back();
+    });
+  };
+  try {
+    runQuietly(tinyConfig(), {broken}, l);
+    FAIL() << "no ValidationFailure";
+  } catch (const ValidationFailure& e) {
+    EXPECT_EQ(e.method(), "bpaccel::BroadPhaseManager, cpu grid 16");
+    EXPECT_EQ(e.difference().missing, 1u);
+  }
 }
 
 TEST(Benchmark, EveryAcceleratorRowNamesTheProfileItIsModelledOn) {
@@ -677,8 +702,8 @@ TEST(DeviceClock, TheDefaultClockIsTheFmaxOfAReportOfTheSameMAndArchitectureOnly
 namespace {
 
 // Runs the real bpaccel binary; returns its exit code and standard output.
-std::pair<int, std::string> runBenchCli(const std::string& args) {
-  const std::string cmd = std::string(BPACCEL_BENCH_CLI) + " run " + args + " 2>/dev/null";
+std::pair<int, std::string> runBenchCli(const std::string& args, const std::string& subcommand = "run") {
+  const std::string cmd = std::string(BPACCEL_BENCH_CLI) + " " + subcommand + " " + args + " 2>/dev/null";
   std::string out;
   FILE* pipe = ::popen(cmd.c_str(), "r");
   std::array<char, 4096> buf{};
@@ -697,10 +722,12 @@ TEST(BenchCli, NamesTheLinkUnitAndListsSkippedMethodsInTableAndJson) {
 
   const auto json = std::filesystem::temp_directory_path() / ("bpaccel-bench-" + std::to_string(::getpid()) + ".json");
   const auto [code, table] = runBenchCli("--objects 40 --frames 1 --warmup 0 --backend model --cell-sizes none 8 "
-                                         "--max-all-pairs-tests 100 --json " + json.string());
+                                         "--max-all-pairs-tests 100 --many-worlds 8 --world-sizes 10 --world-frames 1 "
+                                         "--json " + json.string());
   EXPECT_EQ(code, 0) << table;
   EXPECT_NE(table.find("n=40 btSimpleBroadphase: skipped: tests all pairs"), std::string::npos) << table;
   EXPECT_NE(table.find("n=40 cpu k-d none: skipped"), std::string::npos) << table;
+  EXPECT_NE(table.find("Many worlds: 8 worlds of n boxes"), std::string::npos) << table;
   std::ifstream in(json);
   const auto j = nlohmann::json::parse(in);
   std::size_t skipped = 0;
@@ -716,6 +743,19 @@ TEST(BenchCli, NamesTheLinkUnitAndListsSkippedMethodsInTableAndJson) {
     }
   EXPECT_EQ(profiles, (std::set<std::string>{"ecp5-5g", "gen3x8"}));
   EXPECT_EQ(j["configuration"]["profiles"].size(), 2u);
+  std::filesystem::remove(json);
+}
+
+TEST(BenchCli, TheManyWorldsTableRunsInTheBenchAndAlone) {
+  const auto json = std::filesystem::temp_directory_path() / ("bpaccel-worlds-" + std::to_string(::getpid()) + ".json");
+  const auto [code, table] = runBenchCli("--worlds 8 --world-sizes 10 20 --world-frames 1 --world-warmup 0 --backend model "
+                                         "--json " + json.string(), "worlds");
+  EXPECT_EQ(code, 0) << table;
+  for (const char* s : {"Many worlds: 8 worlds", "n=20", "accelerator ManyWorlds on ecp5-5g", "Every world of every frame validated"})
+    EXPECT_NE(table.find(s), std::string::npos) << s << "\n" << table;
+  std::ifstream in(json);
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["rows"].size(), 2u);
   std::filesystem::remove(json);
 }
 
@@ -761,6 +801,16 @@ std::vector<std::string> exactCpuRowsNamed(std::size_t cpuThreads, const std::st
       EXPECT_EQ(m["kind"], "cpu") << names.back();
       EXPECT_EQ(m["missing_pairs"], 0) << names.back();
       EXPECT_EQ(m["extra_pairs"], 0) << names.back();
+      if (!names.back().ends_with(" threads")) continue;
+      // Its speedup over the same row on one thread, and that per thread.
+      const std::string one = names.back().substr(0, names.back().rfind(", "));
+      for (const auto& o : j["rows"][0]["methods"])
+        if (o["name"] == one) {
+          const double speedup = o["frame_ms"]["median"].get<double>() / m["frame_ms"]["median"].get<double>();
+          EXPECT_DOUBLE_EQ(m["speedup_over_one_thread"].get<double>(), speedup) << names.back();
+          EXPECT_DOUBLE_EQ(m["parallel_efficiency"].get<double>(), speedup / cpuThreads) << names.back();
+        }
+      EXPECT_TRUE(m.contains("parallel_efficiency")) << names.back();
     }
   return names;
 }
@@ -783,4 +833,54 @@ TEST(Benchmark, TheCpuBackendsAutomaticChoiceRunsExactlyBesideTheFixedOnes) {
       EXPECT_EQ(m["cell_size"], "auto");
       EXPECT_EQ(m["partition"], "auto");
     }
+}
+
+namespace {
+
+// btDbvtBroadphase whose ray tests lose the first proxy each ray meets.
+class RayDroppingDbvt final : public btDbvtBroadphase {
+ public:
+  void rayTest(const btVector3& from, const btVector3& to, btBroadphaseRayCallback& callback, const btVector3& lo,
+               const btVector3& hi) override {
+    struct SkipFirst final : btBroadphaseRayCallback {
+      explicit SkipFirst(btBroadphaseRayCallback& inner) : inner(inner) {
+        m_rayDirectionInverse = inner.m_rayDirectionInverse;
+        for (int a = 0; a < 3; ++a) m_signs[a] = inner.m_signs[a];
+        m_lambda_max = inner.m_lambda_max;
+      }
+      bool process(const btBroadphaseProxy* proxy) override { return std::exchange(first, false) || inner.process(proxy); }
+      btBroadphaseRayCallback& inner;
+      bool first = true;
+    } skip(callback);
+    btDbvtBroadphase::rayTest(from, to, skip, lo, hi);
+  }
+};
+
+}  // namespace
+
+TEST(WholeStep, TheRaysAfterEachStepAreTimedAndEveryAnswerChecked) {
+  auto config = tinyConfig();
+  config.objectCounts = {30};
+  config.frames = 1;
+  config.wholeStepObjects = 60;
+  config.wholeStepFrames = 3;
+  config.wholeStepRays = 40;
+  LineUpConfig l;
+  const auto j = runQuietly(config, {fakePeer(0, 1e-3, false)}, l);
+  const auto& w = j["whole_step"];
+  EXPECT_EQ(w["rays_per_frame"], 40);
+  ASSERT_EQ(w["methods"].size(), 2u);
+  for (const auto& m : w["methods"]) {
+    EXPECT_GT(m["ray_proxies"]["reported"].get<std::uint64_t>(), 0u) << m["name"];
+    EXPECT_EQ(m["ray_proxies"]["missing"], 0) << m["name"];
+    EXPECT_GE(m["step_and_rays_ms"]["median"].get<double>(), m["step_ms"]["min"].get<double>()) << m["name"];
+  }
+  EXPECT_EQ(w["methods"][1]["ray_proxies"]["extra"], 0);  // the drop-in's rays: exactly Bullet's test
+  EXPECT_NE(Benchmark::table(j).find("step + rays"), std::string::npos);
+  // A broad phase whose rays lose a proxy is caught by the same check.
+  SceneConfig scene;
+  scene.objects = 60;
+  const auto lossy = timeWholeSteps(scene, [] { return std::make_unique<RayDroppingDbvt>(); },
+                                    {.frames = 2, .warmup = 1, .rays = 40});
+  EXPECT_GT(lossy.rayMissing, 0u);
 }

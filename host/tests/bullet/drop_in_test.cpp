@@ -626,9 +626,14 @@ TEST(DropIn, PrintStatsNamesBackendProxiesAndPairs) {
 TEST(DropIn, WholeStepTimingStepsTheBouncingCube) {
   bpaccel::SceneConfig scene;
   scene.objects = 100;
-  const auto times = bpaccel::timeWholeSteps(scene, accel("cpu", 64), 5, 2);
+  const auto times = bpaccel::timeWholeSteps(scene, accel("cpu", 64), {.frames = 5, .warmup = 2, .rays = 20});
   ASSERT_EQ(times.stepSeconds.size(), 5u);
+  ASSERT_EQ(times.raySeconds.size(), 5u);
   EXPECT_GT(times.median(), 0.0);
+  // Every ray's proxies checked against Bullet's ray-box test: exactly those.
+  EXPECT_GT(times.rayHits, 0u);
+  EXPECT_EQ(times.rayMissing, 0u);
+  EXPECT_EQ(times.rayExtra, 0u);
   EXPECT_THROW(bpaccel::StepTimes{}.median(), std::logic_error);
 }
 
