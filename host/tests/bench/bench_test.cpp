@@ -723,6 +723,7 @@ TEST(BenchCli, NamesTheLinkUnitAndListsSkippedMethodsInTableAndJson) {
   const auto json = std::filesystem::temp_directory_path() / ("bpaccel-bench-" + std::to_string(::getpid()) + ".json");
   const auto [code, table] = runBenchCli("--objects 40 --frames 1 --warmup 0 --backend model --cell-sizes none 8 "
                                          "--max-all-pairs-tests 100 --many-worlds 8 --world-sizes 10 --world-frames 1 "
+                                         "--whole-step-objects 100 --whole-step-rays 10 --query-objects 100 --query-count 10 "
                                          "--json " + json.string());
   EXPECT_EQ(code, 0) << table;
   EXPECT_NE(table.find("n=40 btSimpleBroadphase: skipped: tests all pairs"), std::string::npos) << table;
