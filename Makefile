@@ -152,12 +152,12 @@ test-sanitize: host-sanitize
 print-other-arch:
 	@echo $(if $(filter seed,$(ARCH)),stream,seed)
 
-# libFuzzer targets on the box-file parser and the pair-finding API
+# libFuzzer targets on the box-file parsers and the pair-finding API
 # (host/fuzz/README.md), built with clang, ASan and UBSan; no Verilator needed.
 FUZZ_BUILD   := build/fuzz
 # make test replays each target's committed corpus and searches on for
-# FUZZ_SECONDS (20 s: about 120,000 box-file and 24,000 pairs inputs);
-# fuzz-long is the deep search.
+# FUZZ_SECONDS (20 s: about 24,000 pairs inputs), the two file parsers
+# (box file, Broadmark's .aabbs) for half of it each; fuzz-long is the deep search.
 FUZZ_SECONDS ?= 20
 FUZZ_RUNS    ?= 1000000
 fuzz: deps

@@ -1,135 +1,105 @@
-// bpaccel: the host's command line: the overlapping pairs of a box file.
+// bpaccel: the host's command line.
 //
-//   bpaccel pairs --input FILE [--backend rtl|model|cpu] [--cell-size C|none] [--partition kd|grid] [--stats]
+//   bpaccel pairs --input FILE [--frame K] [--backend cpu|rtl|model] [--cell-size auto|C|none]
+//                 [--partition auto|kd|grid] [--threads T] [--cells-per-batch K] [--repeat N] [--stats]
+//   bpaccel convert --input FILE --output FILE [--frame K]
 //
-// The benchmark has a program of its own (host/bench/tools/bpaccel_bench.cpp).
+// FILE is a text box file or, named *.aabbs, a Broadmark scene. The benchmark
+// has a program of its own (host/bench/tools/bpaccel_bench.cpp).
 
-#include <algorithm>
-#include <fstream>
-#include <iostream>
-#include <memory>
-#include <optional>
+#include <string>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
-#include <fmt/ostream.h>
 
-#include "device/backend.hpp"
-#include "core/box_file.hpp"
 #include "bpaccel_params.h"
-#include "broad_phase/broad_phase.hpp"
-#include "core/keys.hpp"
-#include "core/median.hpp"
-#include "device/rtl/rtl_backend.hpp"
+#include "broad_phase/broad_phase_config.hpp"
+#include "commands.hpp"
 
 namespace {
 
-// The library's parse, as the option's validation error (exit code 2).
-std::optional<std::size_t> parseCellSize(const std::string& text) {
+constexpr const char* kInputHelp =
+    "Scene: a text file, one box a line ('minx miny minz maxx maxy maxz'; # comments), or a Broadmark "
+    "scene (*.aabbs)";
+constexpr const char* kFrameHelp = "Frame of a .aabbs scene: 0 (its initial frame, the default) to its frame count";
+constexpr const char* kBackendHelp =
+    "cpu: the answer, fast (software on every core); "
+    "model: the device's cycle counts (its cycle-exact C++ model); "
+    "rtl: to check the hardware itself (the Verilated AXI shell and core; slow)";
+
+// "auto", "none" or a positive integer; the library's message as the option's error (exit code 2).
+std::string checkCellSize(const std::string& text) {
+  if (text == "auto") return {};
   try {
-    return bpaccel::parseCellSize(text);
-  } catch (const std::invalid_argument& e) {
-    throw CLI::ValidationError("--cell-size", e.what());
+    bpaccel::parseCellSize(text);
+  } catch (const std::invalid_argument&) {
+    return "'" + text + "' is not auto, none or a positive integer";
   }
+  return {};
 }
 
-int runPairs(const std::string& input, const std::string& backendName, const std::string& cellSizeText,
-             bpaccel::PartitionKind partition, std::size_t cellsPerBatch, std::size_t repeat, bool stats) {
-  std::ifstream file(input);
-  if (!file) {
-    fmt::print(stderr, "bpaccel: cannot open '{}'\n", input);
-    return 2;
-  }
-  std::vector<bpaccel::Aabb> boxes;
-  try {
-    boxes = bpaccel::readBoxes(file);
-  } catch (const bpaccel::ParseError& e) {
-    fmt::print(stderr, "bpaccel: {}:{}\n", input, e.what());
-    return 1;
-  }
-  auto backend = bpaccel::makeBuiltBackend(backendName);
-  // --stats times each part of the host's work (the clock is read only then).
-  bpaccel::LastFrameTiming timing;
-  bpaccel::BroadPhase broadPhase(*backend, {.cellSize = parseCellSize(cellSizeText),
-                                            .partition = partition,
-                                            .cellsPerBatch = cellsPerBatch,
-                                            .observer = stats ? &timing : nullptr});
-  std::vector<bpaccel::Pair> pairs;
-  // Each part's host time per repetition; --stats prints their medians.
-  std::vector<double> convert, partitionTime, cells, total, host;
-  for (std::size_t r = 0; r < repeat; ++r) {
-    broadPhase.findPairs(boxes, pairs);
-    const auto& t = timing.times();
-    convert.push_back(t.convertSeconds);
-    partitionTime.push_back(t.partitionSeconds);
-    cells.push_back(t.cellsSeconds);
-    total.push_back(t.totalSeconds);
-    host.push_back(t.totalSeconds - t.backendSeconds);
-  }
-  std::sort(pairs.begin(), pairs.end());
+CLI::App* addPairs(CLI::App& app, bpaccel::app::PairsOptions& o) {
+  auto* cmd = app.add_subcommand("pairs", "Print every overlapping pair 'i j' (i < j, sorted) of a scene");
+  cmd->add_option("--input", o.input, kInputHelp)->required();
+  cmd->add_option("--frame", o.frame, kFrameHelp);
+  cmd->add_option("--backend", o.backend, kBackendHelp)
+      ->check(CLI::IsMember({"cpu", "model", "rtl"}))
+      ->capture_default_str();
+  cmd->add_option("--cell-size", o.cellSize,
+                  "auto (chosen each frame), C (k-d: most boxes a leaf holds; grid: 2n/C cells) or none (one cell)")
+      ->check(checkCellSize)
+      ->capture_default_str();
+  cmd->add_option("--partition", o.partition,
+                  "How cells are made: auto (chosen each frame; with a cell size given, kd), kd (k-d tree, any "
+                  "scene) or grid (uniform grid, near-uniform scenes; falls back to the tree when boxes would join "
+                  "too many cells)")
+      ->check(CLI::IsMember({"auto", "kd", "grid"}))
+      ->capture_default_str();
+  cmd->add_option("--threads", o.threads,
+                  "Threads (0: every hardware thread with cpu, one device with rtl and model)")
+      ->capture_default_str();
+  cmd->add_option("--cells-per-batch", o.cellsPerBatch,
+                  "Cells per hand-over to the device (the hardware's batch front end); 1: each on its own")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--repeat", o.repeat,
+                  "Find the pairs this many times (frames on the same scene); --stats gives each host part's median")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_flag("--stats", o.stats, "Print the backend, threads, partition, cycles and timings to stderr");
+  return cmd;
+}
 
-  std::string text;
-  text.reserve(pairs.size() * 12);
-  for (const auto& [i, j] : pairs) fmt::format_to(std::back_inserter(text), "{} {}\n", i, j);
-  std::fwrite(text.data(), 1, text.size(), stdout);
-
-  if (stats) {
-    const auto& s = broadPhase.stats();
-    fmt::print(stderr,
-               "backend {} cell-size {} partition {} objects {} pairs {}\n"
-               "runs {} batches {} cycles {} issue-cycles {} stall-cycles {} hits {} boxes-sent {} beats {}\n"
-               "host seconds (measured): convert {:.6f} partition {:.6f} cells {:.6f} total {:.6f} "
-               "host-without-backend {:.6f} (median of {} frames)\n",
-               backend->name(), cellSizeText, broadPhase.partition().name(), boxes.size(), pairs.size(), s.runs,
-               s.batches, s.cycles, s.issueCycles, s.stallCycles, s.hits, s.boxesSent, s.beatsReceived,
-               bpaccel::median(convert), bpaccel::median(partitionTime), bpaccel::median(cells),
-               bpaccel::median(total), bpaccel::median(host), repeat);
-  }
-  return 0;
+void addConvert(CLI::App& app, bpaccel::app::ConvertOptions& o) {
+  auto* cmd = app.add_subcommand(
+      "convert",
+      "Convert a scene between the text box format and Broadmark's .aabbs (each file's format from its name). A "
+      ".aabbs written from boxes holds them as its initial frame and its one step");
+  cmd->add_option("--input", o.input, kInputHelp)->required();
+  cmd->add_option("--output", o.output, "Scene to write: *.aabbs for Broadmark's format, else text")->required();
+  cmd->add_option("--frame", o.frame, kFrameHelp);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Broad-phase collision detection on the generated accelerator (m = " + std::to_string(BPACCEL_M) +
-               ", capacity = " + std::to_string(BPACCEL_CAPACITY) + ")"};
+  CLI::App app{"Broad-phase collision detection: every overlapping pair of boxes, exactly. The default is the "
+               "fastest exact answer here (the cpu backend on every core); the generated accelerator (m = " +
+               std::to_string(BPACCEL_M) + ", capacity = " + std::to_string(BPACCEL_CAPACITY) +
+               ") is one option away, --backend rtl or model"};
   app.require_subcommand(1);
-
-  std::string input, backendName = "rtl", cellSize = "none";
-  bool stats = false;
-  auto* pairs = app.add_subcommand("pairs", "Print every overlapping pair 'i j' (i < j, sorted) of a box file");
-  pairs->add_option("--input", input, "Text file: one box a line, 'minx miny minz maxx maxy maxz'; # comments")
-      ->required();
-  pairs->add_option("--backend", backendName, "rtl (Verilated hardware), model (its C++ model) or cpu (software)")
-      ->check(CLI::IsMember({"rtl", "model", "cpu"}))
-      ->capture_default_str();
-  pairs->add_option("--cell-size", cellSize,
-                    "Cell size C (k-d: most boxes a leaf holds; grid: 2n/C cells) or 'none' (one cell)")
-      ->capture_default_str();
-  std::string partitionName = "kd";
-  pairs->add_option("--partition", partitionName,
-                    "How cells are made: kd (k-d tree, any scene) or grid (uniform grid, near-uniform scenes; "
-                    "falls back to the tree when boxes would join too many cells)")
-      ->check(CLI::IsMember({"kd", "grid"}))
-      ->capture_default_str();
-  std::size_t pairsCellsPerBatch = 1;
-  pairs->add_option("--cells-per-batch", pairsCellsPerBatch,
-                    "Cells per hand-over to the backend (the hardware's batch front end); 1: each on its own")
-      ->check(CLI::PositiveNumber)->capture_default_str();
-  pairs->add_flag("--stats", stats, "Print cycles and timings to stderr");
-  std::size_t repeat = 1;
-  pairs->add_option("--repeat", repeat,
-                    "Find the pairs this many times (frames on the same scene); --stats gives each host part's median")
-      ->check(CLI::PositiveNumber)->capture_default_str();
-
-  CLI11_PARSE(app, argc, argv);
+  bpaccel::app::PairsOptions pairs;
+  bpaccel::app::ConvertOptions convert;
+  CLI::App* pairsCmd = addPairs(app, pairs);
+  addConvert(app, convert);
   try {
-    parseCellSize(cellSize);
-    return runPairs(input, backendName, cellSize, bpaccel::parsePartitionKind(partitionName), pairsCellsPerBatch,
-                    repeat, stats);
-  } catch (const CLI::ValidationError& e) {
-    fmt::print(stderr, "bpaccel: {}\n", e.what());
-    return 2;
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // Help prints and exits 0; every error of the command line is exit code 2.
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  try {
+    return *pairsCmd ? bpaccel::app::runPairs(pairs) : bpaccel::app::runConvert(convert);
   } catch (const std::exception& e) {
     fmt::print(stderr, "bpaccel: {}\n", e.what());
     return 1;

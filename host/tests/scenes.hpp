@@ -2,6 +2,7 @@
 // Test scenes and the plain float reference every backend must match.
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -25,6 +26,15 @@ inline std::vector<Pair> bruteForce(const std::vector<Aabb>& boxes) {
       if (hit) pairs.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
     }
   return pairs;
+}
+
+/// The same floats bit for bit (-0 is not 0).
+inline bool sameBits(const Aabb& a, const Aabb& b) {
+  for (int k = 0; k < 3; ++k)
+    if (std::bit_cast<std::uint32_t>(a.min[k]) != std::bit_cast<std::uint32_t>(b.min[k]) ||
+        std::bit_cast<std::uint32_t>(a.max[k]) != std::bit_cast<std::uint32_t>(b.max[k]))
+      return false;
+  return true;
 }
 
 inline std::vector<Pair> sorted(std::vector<Pair> p) {

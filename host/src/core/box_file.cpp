@@ -18,6 +18,8 @@ ParseError::ParseError(std::size_t line, const std::string& reason)
 
 namespace {
 
+constexpr const char* kField[6] = {"minx", "miny", "minz", "maxx", "maxy", "maxz"};
+
 bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
 /// The "C" locale, so strtof reads '.' as the decimal point whatever locale
@@ -51,11 +53,18 @@ bool roundOutOfRange(std::string_view digits, float& value) {
 
 }  // namespace
 
+std::string boxFault(const Aabb& box) {
+  for (int f = 0; f < 6; ++f)
+    if (std::isnan(f < 3 ? box.min[f] : box.max[f - 3])) return fmt::format("{} is NaN", kField[f]);
+  for (int a = 0; a < 3; ++a)
+    if (box.min[a] > box.max[a]) return fmt::format("{} {} > {} {}", kField[a], box.min[a], kField[a + 3], box.max[a]);
+  return {};
+}
+
 std::vector<Aabb> readBoxes(std::istream& in) {
   std::vector<Aabb> boxes;
   std::string text;
   std::size_t lineNo = 0;
-  static constexpr const char* kField[6] = {"minx", "miny", "minz", "maxx", "maxy", "maxz"};
   while (std::getline(in, text)) {
     ++lineNo;
     const auto hash = text.find('#');
@@ -90,10 +99,8 @@ std::vector<Aabb> readBoxes(std::istream& in) {
     if (fields == 0) continue;
     if (fields != 6)
       throw ParseError(lineNo, fmt::format("{} fields, expected 6 (minx miny minz maxx maxy maxz)", fields));
-    Aabb box{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
-    for (int a = 0; a < 3; ++a)
-      if (box.min[a] > box.max[a])
-        throw ParseError(lineNo, fmt::format("{} {} > {} {}", kField[a], box.min[a], kField[a + 3], box.max[a]));
+    const Aabb box{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+    if (const std::string fault = boxFault(box); !fault.empty()) throw ParseError(lineNo, fault);
     if (boxes.size() == kMaxObjects) throw ParseError(lineNo, "too many boxes for 32-bit indices");
     boxes.push_back(box);
   }

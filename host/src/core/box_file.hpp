@@ -22,6 +22,10 @@ class ParseError : public std::runtime_error {
   std::size_t line_;
 };
 
+/// Empty for a box the broad phase takes; else its first fault, named as
+/// the box readers name it: "minx is NaN", "minx 2 > maxx 1".
+std::string boxFault(const Aabb& box);
+
 /// Reads `minx miny minz maxx maxy maxz` lines; blank lines and `#` comments
 /// are skipped. Numbers are rounded to float exactly as C's strtof rounds
 /// them: values too small for a normal float become the nearest denormal or

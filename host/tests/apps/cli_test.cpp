@@ -1,36 +1,24 @@
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
-#include <filesystem>
 #include <fstream>
-#include <sys/wait.h>
+#include <regex>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "apps/run_cli.hpp"
+#include "core/box_file.hpp"
+#include "scenes.hpp"
 
 namespace {
 
-struct Result {
-  int exitCode;
-  std::string out;
-  std::string err;
-};
+using bpaccel::testing::CliResult;
 
-// Runs the real bpaccel binary on a file holding `content`.
-Result runCli(const std::string& content, const std::string& args) {
-  const auto dir = std::filesystem::temp_directory_path() / ("bpaccel-cli-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const auto input = dir / "boxes.txt", err = dir / "err.txt";
+// `bpaccel pairs` on a text file holding `content`.
+CliResult runCli(const std::string& content, const std::string& args) {
+  const auto input = bpaccel::testing::cliTestDir() / "boxes.txt";
   std::ofstream(input) << content;
-  const std::string cmd = std::string(BPACCEL_CLI) + " pairs --input " + input.string() + " " + args + " 2>" +
-                          err.string();
-  Result r{};
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  std::size_t got;
-  while ((got = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) r.out.append(buf.data(), got);
-  r.exitCode = WEXITSTATUS(::pclose(pipe));
-  std::ifstream e(err);
-  r.err.assign(std::istreambuf_iterator<char>(e), {});
-  return r;
+  return bpaccel::testing::runBpaccel("pairs --input " + input.string() + " " + args);
 }
 
 const char* kScene =
@@ -105,4 +93,75 @@ TEST(Cli, RejectsBadOptions) {
   const auto r = runCli(kScene, "--cell-size 0");
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_NE(r.err.find("--cell-size"), std::string::npos) << r.err;
+}
+
+namespace {
+
+// The pairs as the program prints them.
+std::string pairsText(const std::vector<bpaccel::Pair>& pairs) {
+  std::string text;
+  for (const auto& [i, j] : bpaccel::testing::sorted(pairs)) text += fmt::format("{} {}\n", i, j);
+  return text;
+}
+
+std::string boxesText(const std::vector<bpaccel::Aabb>& boxes) {
+  std::ostringstream text;
+  bpaccel::writeBoxes(text, boxes);
+  return text.str();
+}
+
+std::size_t hardwareThreads() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+}  // namespace
+
+// A newcomer's first command: no option but the input. It must be the
+// software backend, its partition and cell size chosen for the scene (a
+// partition, not one cell of 3000 boxes), on every hardware thread, and exact.
+TEST(Cli, TheDefaultIsTheCpuBackendWithItsOwnPartitionOnEveryCore) {
+  const auto boxes = bpaccel::testing::scatteredBoxes(3000, 45, 0, 1000, 1, 30);
+  const auto r = runCli(boxesText(boxes), "--stats");
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.out, pairsText(bpaccel::testing::bruteForce(boxes)));
+  const std::regex fastPath(fmt::format(R"(^backend cpu threads {} cell-size [0-9]+ \(auto\) partition (grid|k-d) )"
+                                        R"(\(auto\) objects 3000 )",
+                                        hardwareThreads()));
+  EXPECT_TRUE(std::regex_search(r.err, fastPath)) << r.err;
+}
+
+TEST(Cli, TheHardwareBackendsAreOneOptionAwayOnOneDevice) {
+  for (const char* backend : {"rtl", "model"}) {
+    const auto r = runCli(kScene, std::string("--backend ") + backend + " --stats");
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.out, "0 1\n0 3\n") << backend;
+    EXPECT_NE(r.err.find(fmt::format("backend {} threads 1 ", backend)), std::string::npos) << r.err;
+  }
+}
+
+TEST(Cli, ThreadsAndAFixedPartitionAreHonoured) {
+  const auto boxes = bpaccel::testing::scatteredBoxes(500, 7, 0, 100, 1, 10);
+  const std::string expected = pairsText(bpaccel::testing::bruteForce(boxes));
+  for (const char* threads : {"1", "2", "3"})
+    for (const char* backend : {"cpu", "model"}) {
+      const auto r = runCli(boxesText(boxes), fmt::format("--backend {} --threads {} --stats", backend, threads));
+      EXPECT_EQ(r.exitCode, 0) << r.err;
+      EXPECT_EQ(r.out, expected) << backend << " " << threads;
+      EXPECT_NE(r.err.find(fmt::format("backend {} threads {} ", backend, threads)), std::string::npos) << r.err;
+    }
+  const auto r = runCli(boxesText(boxes), "--cell-size 32 --stats");
+  EXPECT_EQ(r.out, expected);
+  EXPECT_NE(r.err.find("cell-size 32 partition k-d objects"), std::string::npos) << r.err;
+  const auto grid = runCli(boxesText(boxes), "--partition grid --stats");
+  EXPECT_EQ(grid.out, expected);
+  EXPECT_NE(grid.err.find(" (auto) partition grid objects"), std::string::npos) << grid.err;
+}
+
+TEST(Cli, HelpSaysWhenToUseEachBackend) {
+  const auto r = bpaccel::testing::runBpaccel("pairs --help");
+  EXPECT_EQ(r.exitCode, 0);
+  // CLI11 wraps long help text; compare with the line breaks taken out.
+  const std::string help = std::regex_replace(r.out, std::regex(R"(\s+)"), " ");
+  for (const char* use : {"cpu: the answer, fast", "model: the device's cycle counts",
+                          "rtl: to check the hardware itself"})
+    EXPECT_NE(help.find(use), std::string::npos) << use << " in " << r.out;
+  EXPECT_TRUE(std::regex_search(help, std::regex(R"(--backend \S*=cpu )"))) << r.out;
 }
