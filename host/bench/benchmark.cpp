@@ -109,6 +109,9 @@ std::vector<MethodSpec> standardLineUp(const LineUpConfig& config) {
     for (auto& s : acceleratorMethods(device, gridCells, config.maxAllPairsTests, PartitionKind::UniformGrid))
       specs.push_back(std::move(s));
   }
+  // The binning device (its C++ model) under each profile: the host sends each box once.
+  if (config.device)
+    for (auto& s : binningMethods(builtBinningParams(), config.profiles)) specs.push_back(std::move(s));
   for (auto& s : cpuMethods(config.cellSizes, config.maxAllPairsTests)) specs.push_back(std::move(s));
   for (auto& s : cpuMethods(gridCells, config.maxAllPairsTests, PartitionKind::UniformGrid))
     specs.push_back(std::move(s));

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "methods/accelerator_method.hpp"
+#include "methods/binning_method.hpp"
 #include "query_bench.hpp"
 #include "scene.hpp"
 #include "scene_families.hpp"
