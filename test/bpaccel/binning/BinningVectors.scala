@@ -28,7 +28,7 @@ object BinningVectors {
     val rng = new Random(4141)
     val random = for (round <- 0 until 6; (name, boxes) <- {
       val (shift, dims) = BinScenes.grid(rng, p)
-      val n = Seq(0, 1, 7, 60, 300, 900)(round)
+      val n = Seq(0, 1, 7, 60, 300, 500)(round)
       BinScenes.all(rng, n, shift, dims).map { case (nm, b) => (s"$nm n=$n s=$shift d=${dims.mkString("x")}", BinFrame(b, shift, dims)) }
     }) yield (name, boxes)
     val (bench, edge) = BinScenes.benchLike(new Random(1), 8000)
@@ -61,14 +61,20 @@ object BinningVectors {
       s""""entries": ${r.binned.entries}, "pairs": ${r.pairs.length}, "pair_hash": "${java.lang.Long.toUnsignedString(hash)}"$phases}"""
   }
 
-  def main(args: Array[String]): Unit = {
-    val out = Paths.get(args.headOption.getOrElse("host/tests/device/binning/binning_cycle_vectors.json"))
+  val committed: String = "host/tests/device/binning/binning_cycle_vectors.json"
+
+  /** The file's text for the default parameters. */
+  def render(): String = {
     val p = BinningParams()
     val scenes = frames(p).map { case (name, f) => sceneJson(p, name, f) }
-    val text = s"""{"generator": "bpaccel.binning.BinningVectors", "fingerprint": "${p.fingerprint}",\n"scenes": [\n""" +
+    s"""{"generator": "bpaccel.binning.BinningVectors", "fingerprint": "${p.fingerprint}",\n"scenes": [\n""" +
       scenes.mkString(",\n") + "\n]}\n"
+  }
+
+  def main(args: Array[String]): Unit = {
+    val out = Paths.get(args.headOption.getOrElse(committed))
     Files.createDirectories(out.getParent)
-    Files.writeString(out, text)
-    println(s"wrote ${scenes.length} frames to $out")
+    Files.writeString(out, render())
+    println(s"wrote the vectors to $out")
   }
 }
