@@ -69,19 +69,30 @@ void BinningFrame::plan(std::span<const Aabb> boxes) {
   int axis = 0;
   for (int a = 1; a < 3; ++a) axis = hi[a] - lo[a] > hi[axis] - lo[axis] ? a : axis;
   const std::size_t slabs = (ids.size() + p.boxCapacity * 9 / 10 - 1) / (p.boxCapacity * 9 / 10);
-  std::vector<double> mins;
+  std::vector<float> mins;
+  mins.reserve(ids.size());
   for (std::uint32_t i : ids) mins.push_back(boxes[i].min[axis]);
-  std::sort(mins.begin(), mins.end());
+  // The cuts: the mins at the quantiles k / slabs, each found by a selection within the part above the last.
   std::vector<double> cuts{-HUGE_VAL};
-  for (std::size_t k = 1; k < slabs; ++k)
-    if (mins[k * mins.size() / slabs] > cuts.back()) cuts.push_back(mins[k * mins.size() / slabs]);
-  cuts.push_back(HUGE_VAL);
-  for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
-    std::vector<std::uint32_t> slab;
-    for (std::uint32_t i : ids)
-      if (boxes[i].min[axis] < cuts[k + 1] && boxes[i].max[axis] >= cuts[k]) slab.push_back(i);
-    if (!slab.empty()) frames_.push_back(makeFrame(std::move(slab), axis, cuts[k], cuts[k + 1]));
+  auto from = mins.begin();
+  for (std::size_t k = 1; k < slabs; ++k) {
+    const auto at = mins.begin() + static_cast<std::ptrdiff_t>(k * mins.size() / slabs);
+    std::nth_element(from, at, mins.end());
+    if (*at > cuts.back()) cuts.push_back(*at);
+    from = at;
   }
+  cuts.push_back(HUGE_VAL);
+  // Each box into every slab its extent on the axis meets: [lo, hi) meets [min, max] when min < hi and max >= lo.
+  std::vector<std::vector<std::uint32_t>> parts(cuts.size() - 1);
+  for (std::uint32_t i : ids) {
+    const auto last = std::upper_bound(cuts.begin(), cuts.end(), double{boxes[i].max[axis]}) - cuts.begin() - 1;
+    for (auto k = std::lower_bound(cuts.begin() + 1, cuts.end(), double{boxes[i].min[axis]},
+                                   [](double cut, double m) { return cut <= m; }) - cuts.begin() - 1;
+         k <= last; ++k)
+      parts[static_cast<std::size_t>(k)].push_back(i);
+  }
+  for (std::size_t k = 0; k < parts.size(); ++k)
+    if (!parts[k].empty()) frames_.push_back(makeFrame(std::move(parts[k]), axis, cuts[k], cuts[k + 1]));
 }
 
 PlannedFrame BinningFrame::makeFrame(std::vector<std::uint32_t> ids, int axis, double lo, double hi) {
