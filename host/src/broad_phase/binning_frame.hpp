@@ -59,7 +59,8 @@ class BinningFrame {
   void findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out);
   /// The steps of findPairs, for a caller that times them: plan (checks,
   /// grid, keys, slabs), send (the frames to the device, and their replies
-  /// kept), collect (decode, recheck, the host's exact path).
+  /// kept), collect (decode, recheck, the host's exact path). plan's boxes
+  /// are read until collect returns: they must stay alive and unchanged.
   void plan(std::span<const Aabb> boxes);
   void send();
   void collect(std::vector<Pair>& out);

@@ -17,8 +17,8 @@ using Cycle = std::uint64_t;
 class Intake {
  public:
   Intake(const BinningParams& p, const FrameCommand& f, const Binned& binned);
-  /// Plays cycle t; true when t is the intake's last cycle (T).
-  bool step(Cycle t);
+  /// Plays one cycle; true when it is the intake's last (T).
+  bool step();
   std::vector<std::uint64_t> written;  // entries each group has written
   std::uint64_t boxesReceived = 0;
 
@@ -69,7 +69,7 @@ const std::vector<std::vector<std::uint8_t>>& Intake::beatEntries(std::size_t k)
   return scratch_;
 }
 
-bool Intake::step(Cycle) {
+bool Intake::step() {
   const bool quiet = lastTaken_ && !register_ && !wroteLast_ &&
                      std::all_of(beatQ_.begin(), beatQ_.end(), [](const auto& q) { return q.empty(); });
   if (quiet) return true;
@@ -274,7 +274,7 @@ void OutputPath::commit(std::vector<GroupTimeline>& groups, std::vector<Pair>& s
   }
 }
 
-void summarize(const BinningParams& p, const Binned& binned, PlayedFrame& played) {
+void summarize(const Binned& binned, PlayedFrame& played) {
   FrameReply& r = played.reply;
   for (const auto& g : binned.groups) {
     r.entries += g.size();
@@ -289,7 +289,6 @@ void summarize(const BinningParams& p, const Binned& binned, PlayedFrame& played
   r.phases.sort = played.computeStart[worst] - played.sortStart[worst];
   r.phases.compute = last - played.computeStart[worst];
   r.phases.drain = r.cycles - last;
-  (void)p;
 }
 
 }  // namespace
@@ -313,7 +312,7 @@ PlayedFrame playFrame(const BinningParams& p, const FrameCommand& f, const Binne
       steps[g] = afterIntake && t >= groups[g].computeAt && !groups[g].done ? groups[g].decide() : GroupStep{};
     output.decide(groups);
     const bool outputEmpty = output.empty(groups);
-    if (!intakeDone && intake.step(t)) {
+    if (!intakeDone && intake.step()) {
       intakeDone = t;
       if (!binned.ok()) finished = t + p.localCells();  // the cell tables are cleared, a row a cycle
       const auto local = p.localDims(f.dims);
@@ -339,7 +338,7 @@ PlayedFrame playFrame(const BinningParams& p, const FrameCommand& f, const Binne
     played.computeStart.push_back(groups[g].computeAt);
     played.groupDone.push_back(*groups[g].done);
   }
-  summarize(p, binned, played);
+  summarize(binned, played);
   return played;
 }
 
