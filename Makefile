@@ -79,6 +79,7 @@ test: deps
 # which spares each an sbt start-up.
 test-hw: deps
 	$(SBT) test $(if $(call stale,$(HOST_VERILOG)/filelist.f),$(EMIT_HOST)) \
+	  $(if $(call stale,$(BINNING_PARAMS_DIR)/bpaccel_binning_params.h),$(EMIT_BINNING_PARAMS)) \
 	  $(if $(call stale,$(FPGA_TEST_VERILOG)/filelist.f $(FPGA_TEST_STREAM_VERILOG)/filelist.f),$(EMIT_FPGA_TEST))
 
 # The formal checks at depths that cover a whole run of each small
@@ -91,8 +92,15 @@ EMIT_HOST = "runMain bpaccel.shell.EmitShell $(EMIT_ARGS) --stream-bits $(HOST_S
 $(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) $(wildcard src/bpaccel/shell/*.scala) | deps
 	$(SBT) $(EMIT_HOST)
 
-host: deps $(HOST_VERILOG)/filelist.f
-	cmake -S host -B $(HOST_BUILD) -G Ninja -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BIN_DIR=$(abspath $(HOST_BIN_DIR))
+# The binning device's C header and JSON parameters (EmitBinning --params-only), for the host's model of it.
+BINNING_PARAMS_DIR := build/host-binning
+EMIT_BINNING_PARAMS = "runMain bpaccel.binning.EmitBinning --params-only --target-dir $(BINNING_PARAMS_DIR)"
+$(BINNING_PARAMS_DIR)/bpaccel_binning_params.h: $(SCALA_SOURCES) $(wildcard src/bpaccel/binning/*.scala) | deps
+	$(SBT) $(EMIT_BINNING_PARAMS)
+
+host: deps $(HOST_VERILOG)/filelist.f $(BINNING_PARAMS_DIR)/bpaccel_binning_params.h
+	cmake -S host -B $(HOST_BUILD) -G Ninja -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BIN_DIR=$(abspath $(HOST_BIN_DIR)) \
+	  -DBPACCEL_BINNING_DIR=$(abspath $(BINNING_PARAMS_DIR))
 	cmake --build $(HOST_BUILD) -j 2
 
 test-host: host
@@ -136,9 +144,10 @@ bench-large-run: host
 HOST_SANITIZE_BUILD := build/host-asan-$(DESIGN_NAME)
 SANITIZER_ENV := ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1:strict_init_order=1 \
                  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-host-sanitize: deps $(HOST_VERILOG)/filelist.f
+host-sanitize: deps $(HOST_VERILOG)/filelist.f $(BINNING_PARAMS_DIR)/bpaccel_binning_params.h
 	cmake -S host -B $(HOST_SANITIZE_BUILD) -G Ninja -C host/cmake/sanitize.cmake \
-	  -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BIN_DIR=$(abspath $(HOST_SANITIZE_BUILD))/bin
+	  -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BIN_DIR=$(abspath $(HOST_SANITIZE_BUILD))/bin \
+	  -DBPACCEL_BINNING_DIR=$(abspath $(BINNING_PARAMS_DIR))
 	cmake --build $(HOST_SANITIZE_BUILD) -j 2
 
 # CI runs it after `make test` (.ci/run): its build and run take about as long

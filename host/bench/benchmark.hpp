@@ -13,6 +13,7 @@
 
 #include "methods/accelerator_method.hpp"
 #include "many_worlds_bench.hpp"
+#include "methods/binning_method.hpp"
 #include "query_bench.hpp"
 #include "scene.hpp"
 #include "scene_families.hpp"

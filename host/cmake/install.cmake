@@ -14,6 +14,11 @@ install(TARGETS bpaccel_core bpaccel_partition bpaccel_query bpaccel_device bpac
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   FILE_SET HEADERS DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bpaccel
   FILE_SET params DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bpaccel/device)
+install(TARGETS bpaccel_binning
+  EXPORT bpaccelTargets
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  FILE_SET HEADERS DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bpaccel
+  FILE_SET binparams DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bpaccel/device/binning)
 set(_bpaccel_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/bpaccel)
 install(EXPORT bpaccelTargets NAMESPACE bpaccel:: DESTINATION ${_bpaccel_cmake_dir})
 # The FCL manager, where it was built: the package's optional component `fcl`

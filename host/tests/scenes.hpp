@@ -37,6 +37,15 @@ inline bool sameBits(const Aabb& a, const Aabb& b) {
   return true;
 }
 
+/// All pairs by the definition, on keys (for scenes given as keys).
+inline std::vector<Pair> bruteForceKeys(const std::vector<KeyBox>& keys) {
+  std::vector<Pair> pairs;
+  for (std::uint32_t i = 0; i < keys.size(); ++i)
+    for (std::uint32_t j = i + 1; j < keys.size(); ++j)
+      if (overlaps(keys[i], keys[j])) pairs.emplace_back(i, j);
+  return pairs;
+}
+
 inline std::vector<Pair> sorted(std::vector<Pair> p) {
   std::sort(p.begin(), p.end());
   return p;

@@ -8,6 +8,7 @@
 #include <tbb/task_group.h>
 
 #include "../core/keys.hpp"
+#include "binning_frame.hpp"
 #include "hand_over.hpp"
 #include "host_frame.hpp"
 #include "timing.hpp"
@@ -74,6 +75,13 @@ void BroadPhase::startWorkers(const std::function<std::unique_ptr<Worker>()>& ma
   if (config_.threads > 1) pool_ = std::make_unique<Pool>(config_.threads);
 }
 
+BroadPhase::BroadPhase(FrameDevice& device, const BroadPhaseConfig& config) : config_(config) {
+  config_.check();
+  if (config_.threads != 1 || config_.handOvers != HandOvers::Synchronous)
+    throw std::invalid_argument("broad phase: a binning device runs one thread with synchronous hand-overs");
+  binning_ = std::make_unique<BinningFrame>(device);
+}
+
 BroadPhase::~BroadPhase() = default;
 
 void BroadPhase::awakenDevices() {
@@ -82,9 +90,12 @@ void BroadPhase::awakenDevices() {
 }
 
 const RunStats& BroadPhase::stats() const { return host_ ? host_->stats() : stats_; }
-const Partition& BroadPhase::partition() const { return host_ ? host_->partition() : *partition_; }
+const Partition& BroadPhase::partition() const {
+  if (binning_) throw std::logic_error("broad phase: a binning device partitions the scene itself");
+  return host_ ? host_->partition() : *partition_;
+}
 const CellChoice& BroadPhase::choice() const { return host_ ? host_->choice() : choice_; }
-std::size_t BroadPhase::threads() const { return host_ ? host_->threads() : workers_.size(); }
+std::size_t BroadPhase::threads() const { return host_ ? host_->threads() : binning_ ? 1 : workers_.size(); }
 
 void BroadPhase::chooseCells(std::size_t objects, const KeyBounds* bounds) {
   if (config_.cellSize.isAutomatic()) {
@@ -102,6 +113,17 @@ BroadPhase::Clock::time_point BroadPhase::now() const {
 }
 
 void BroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) {
+  if (binning_) {
+    binning_->findPairs(boxes, out);
+    const BinningFrameStats& b = binning_->stats();
+    stats_ = {};
+    stats_.runs = stats_.batches = b.slabs + b.retries;
+    stats_.cycles = b.deviceCycles;
+    stats_.issueCycles = b.issueCycles;
+    stats_.hits = b.devicePairs;
+    stats_.boxesSent = b.boxesSent;
+    return;
+  }
   if (host_) {
     host_->findPairs(boxes, out);
     if (config_.observer) config_.observer->frameFinished(host_->timing());
@@ -127,6 +149,7 @@ void BroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) 
 }
 
 void BroadPhase::findPairs(std::span<const KeyBox> keys, std::vector<Pair>& out) {
+  if (binning_) throw std::logic_error("broad phase: a binning device takes float boxes, not keys");
   if (host_) {
     host_->findPairs(keys, out);
     if (config_.observer) config_.observer->frameFinished(host_->timing());

@@ -19,6 +19,8 @@
 
 namespace bpaccel {
 
+class BinningFrame;
+class FrameDevice;
 class HostFrame;
 class Worker;
 
@@ -51,6 +53,12 @@ class BroadPhase {
   explicit BroadPhase(Backend& backend, const BroadPhaseConfig& config = {});
   /// config.threads workers, each with a device of its own from `makeBackend`.
   explicit BroadPhase(const BackendFactory& makeBackend, const BroadPhaseConfig& config = {});
+  /// On a binning device (which must outlive it): the device partitions the
+  /// scene itself; the host sends each box once and rechecks the pairs
+  /// (BinningFrame). One thread, synchronous; the config's partition, cell
+  /// size and batches do not apply. Only float boxes (the host quantizes them
+  /// onto the frame's grid): findPairs on keys throws std::logic_error.
+  explicit BroadPhase(FrameDevice& device, const BroadPhaseConfig& config = {});
   ~BroadPhase();
   BroadPhase(const BroadPhase&) = delete;
   BroadPhase& operator=(const BroadPhase&) = delete;
@@ -93,6 +101,7 @@ class BroadPhase {
 
   BroadPhaseConfig config_;
   std::unique_ptr<HostFrame> host_;  // the cpu backend's path; else the workers below
+  std::unique_ptr<BinningFrame> binning_;  // the binning device's path
   std::vector<std::unique_ptr<Worker>> workers_;
   std::unique_ptr<Pool> pool_;  // only with more than one worker
   std::size_t capacity_ = 0;

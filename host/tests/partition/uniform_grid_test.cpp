@@ -35,15 +35,6 @@ void expectExactOnGrid(Backend& backend, const std::vector<Aabb>& boxes, std::si
   expectExactOnGrid(backend, boxes, cell, what, bruteForce(boxes));
 }
 
-// All pairs by the definition, on keys (for scenes given as keys).
-std::vector<Pair> bruteForceKeys(const std::vector<KeyBox>& keys) {
-  std::vector<Pair> pairs;
-  for (std::uint32_t i = 0; i < keys.size(); ++i)
-    for (std::uint32_t j = i + 1; j < keys.size(); ++j)
-      if (overlaps(keys[i], keys[j])) pairs.emplace_back(i, j);
-  return pairs;
-}
-
 // The partition's contract: the cells' regions cover key space without
 // overlap, and a box is in a cell exactly when it touches the cell's region.
 void expectCellsPartitionSpaceAndHoldExactlyTheirBoxes(const Partition& p, const std::vector<KeyBox>& keys,

@@ -30,8 +30,7 @@ object EmitBinning {
       throw new IllegalArgumentException(s"EmitBinning: the cell table's memory module $table is also a group memory's; " +
         "change groupCapacity or cellBits")
     DistributedMemories.rewrite(targetDir, Seq(table))
-    Files.writeString(targetDir.resolve(headerFile), BinningHeader.cHeader(p))
-    Files.writeString(targetDir.resolve(jsonFile), BinningHeader.json(p))
+    emitParams(p, targetDir)
     Files.writeString(targetDir.resolve(EmitVerilog.lintWaivers), lintWaiverText)
     targetDir.resolve("filelist.f")
   }
@@ -41,7 +40,15 @@ object EmitBinning {
     "`verilator_config\n" +
       "lint_off -rule UNUSEDSIGNAL -file \"*ram_*.sv\" -match \"*R0_clk*\"\n"
 
-  private case class Options(p: BinningParams = BinningParams(), targetDir: Path = Paths.get("generated/binning"))
+  /** The C header and JSON parameter file alone (what the host is compiled against), without the Verilog. */
+  def emitParams(p: BinningParams, targetDir: Path): Unit = {
+    Files.createDirectories(targetDir)
+    Files.writeString(targetDir.resolve(headerFile), BinningHeader.cHeader(p))
+    Files.writeString(targetDir.resolve(jsonFile), BinningHeader.json(p))
+  }
+
+  private case class Options(p: BinningParams = BinningParams(), targetDir: Path = Paths.get("generated/binning"),
+                             paramsOnly: Boolean = false)
 
   def main(args: Array[String]): Unit = {
     val d = BinningParams()
@@ -61,9 +68,14 @@ object EmitBinning {
       opt[String]("memory-style").action((v, o) => o.copy(p = o.p.copy(memoryStyle = MemoryStyle.fromName(v))))
         .text(s"${MemoryStyle.all.map(_.name).mkString(" or ")} (default ${d.memoryStyle.name})")
       opt[Boolean]("debug-port").action((v, o) => o.copy(p = o.p.copy(debugPort = v)))
+      opt[Unit]("params-only").action((_, o) => o.copy(paramsOnly = true))
+        .text("write only the C header and the JSON parameter file")
       opt[String]("target-dir").action((v, o) => o.copy(targetDir = Paths.get(v))).text("output folder")
     }
     parser.parse(args, Options()) match {
+      case Some(o) if o.paramsOnly =>
+        emitParams(o.p, o.targetDir)
+        println(s"wrote $headerFile and $jsonFile in ${o.targetDir} for ${o.p}")
       case Some(o) =>
         val out = emit(o.p, o.targetDir)
         println(s"wrote $out, $headerFile and $jsonFile for ${o.p}")

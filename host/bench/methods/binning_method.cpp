@@ -1,0 +1,86 @@
+#include "binning_method.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+namespace bpaccel {
+
+std::size_t frameBoxBytes(unsigned keyWidth) { return keyWidth <= 16 ? 12 : 24; }
+std::size_t framePairBytes(unsigned indexWidth) { return indexWidth <= 16 ? 4 : 8; }
+
+BinningFrameModel modelBinningFrame(const BinningFrameStats& stats, const BinningParams& params,
+                                    const DeviceProfile& profile) {
+  const double clock = profile.part.clockHz.value, bandwidth = profile.link.effectiveBytesPerSecond.value;
+  const double frames = static_cast<double>(stats.slabs + stats.retries);
+  const double boxBytes = static_cast<double>(stats.boxesSent * frameBoxBytes(params.keyWidth)) +
+                          frames * kFrameHeaderBytes;
+  const double backBytes = static_cast<double>(stats.devicePairs * framePairBytes(params.indexWidth())) +
+                           frames * kFrameTrailerBytes;
+  BinningFrameModel m;
+  m.deviceSeconds = static_cast<double>(stats.deviceCycles) / clock;
+  // The intake takes the boxes as they arrive: the link adds only what it is slower than the intake.
+  const double intakeSeconds = static_cast<double>(stats.phases.intake) / clock;
+  m.transferSeconds = 2 * frames * profile.link.latencySeconds.value +
+                      std::max(0.0, boxBytes / bandwidth - intakeSeconds) + backBytes / bandwidth;
+  return m;
+}
+
+FrameReply TimedFrameDevice::runFrame(const FrameCommand& command) {
+  const auto t0 = std::chrono::steady_clock::now();
+  FrameReply r = inner_.runFrame(command);
+  seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+BinningMethod::BinningMethod(const BinningParams& params, DeviceProfile profile)
+    : device_(params), timed_(device_), frame_(timed_), profile_(std::move(profile)) {}
+
+void BinningMethod::update(std::span<const Aabb> boxes) {
+  using Clock = std::chrono::steady_clock;
+  const auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
+  timed_.seconds = 0;
+  const auto t0 = Clock::now();
+  frame_.plan(boxes);
+  const auto t1 = Clock::now();
+  frame_.send();
+  const auto t2 = Clock::now();
+  frame_.collect(pairs_);
+  const auto t3 = Clock::now();
+  planSeconds_ = seconds(t0, t1), collectSeconds_ = seconds(t2, t3);
+  simulationSeconds_ = timed_.seconds;  // the model stands in for the card: its time is not host work
+}
+
+FrameTime BinningMethod::frameTime(double measuredSeconds) const {
+  const BinningFrameStats& s = frame_.stats();
+  const BinningFrameModel m = modelBinningFrame(s, device_.params(), profile_);
+  ModelledParts p;
+  p.hostSeconds = measuredSeconds - simulationSeconds_;
+  p.deviceSeconds = m.deviceSeconds;
+  p.transferSeconds = m.transferSeconds;
+  p.stats.runs = p.stats.batches = s.slabs + s.retries;
+  p.stats.cycles = s.deviceCycles;
+  p.stats.issueCycles = s.issueCycles;
+  p.stats.hits = s.devicePairs;
+  p.stats.boxesSent = s.boxesSent;
+  return {p.hostSeconds + p.deviceSeconds + p.transferSeconds, p};
+}
+
+std::vector<MethodSpec> binningMethods(const BinningParams& params, const std::vector<DeviceProfile>& profiles) {
+  std::vector<MethodSpec> specs;
+  for (const DeviceProfile& profile : profiles) {
+    MethodSpec s;
+    s.name = "accelerator binning on " + profile.name;
+    s.kind = MethodKind::Accelerator;
+    s.library = "bpaccel";
+    s.partition = "binning";
+    s.profile = profile.toJson();
+    s.profile["binning_clock_note"] =
+        "no place-and-route report of the binning design yet: the profile's clock (" + profile.part.clockHz.source +
+        ") stands in, modelled";
+    s.make = [params, profile](const SceneStart&) { return std::make_unique<BinningMethod>(params, profile); };
+    specs.push_back(std::move(s));
+  }
+  return specs;
+}
+
+}  // namespace bpaccel

@@ -1,0 +1,77 @@
+#pragma once
+// The binning device as a benchmark method: the host's frame path measured,
+// the device's cycles from its cycle-exact C++ model, the link modelled, on a
+// named DeviceProfile.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "broad_phase/binning_frame.hpp"
+#include "device/binning/binning_model.hpp"
+#include "model/device_profile.hpp"
+#include "timed_method.hpp"
+
+namespace bpaccel {
+
+/// Bytes of one box in a FRAME packet: six keys, a half-word each up to 16 bits, else a word (docs/protocol.md).
+std::size_t frameBoxBytes(unsigned keyWidth);
+/// Bytes of one pair record in a FRAME reply: one word up to 16-bit indices, else two.
+std::size_t framePairBytes(unsigned indexWidth);
+/// A FRAME packet's header (4 words) and a reply's trailer (8 words).
+inline constexpr std::size_t kFrameHeaderBytes = 16, kFrameTrailerBytes = 32;
+
+/// One frame's modelled link and device time on `profile`, from what the frame sent and got back:
+///   device = cycles / clock;
+///   link   = 2 latencies per device frame + the boxes' bytes beyond what the
+///            intake takes in the same time + the pair records and trailers back.
+struct BinningFrameModel {
+  double deviceSeconds = 0;
+  double transferSeconds = 0;
+};
+BinningFrameModel modelBinningFrame(const BinningFrameStats& stats, const BinningParams& params,
+                                    const DeviceProfile& profile);
+
+/// A FrameDevice that passes each frame on and adds up the time it took: the
+/// model's own run, which stands in for the card and is no host work.
+class TimedFrameDevice final : public FrameDevice {
+ public:
+  explicit TimedFrameDevice(FrameDevice& inner) : inner_(inner) {}
+  std::string name() const override { return inner_.name(); }
+  const BinningParams& params() const override { return inner_.params(); }
+  FrameReply runFrame(const FrameCommand& command) override;
+  double seconds = 0;
+
+ private:
+  FrameDevice& inner_;
+};
+
+/// "accelerator binning on <profile>": BinningFrame on a BinningModel.
+/// Host = the measured frame minus the time spent simulating the device
+/// (every runFrame, retries too; the host's own work between them counts).
+class BinningMethod final : public TimedMethod {
+ public:
+  BinningMethod(const BinningParams& params, DeviceProfile profile);
+  void update(std::span<const Aabb> boxes) override;
+  void pairs(std::vector<Pair>& out) override { out = pairs_; }
+  FrameTime frameTime(double measuredSeconds) const override;
+  const BinningFrameStats& stats() const { return frame_.stats(); }
+  const BinningFrame& frame() const { return frame_; }
+  /// The last update's measured host parts: plan (checks, grid, keys, slabs) and collect (decode, recheck);
+  /// the host's work inside send (cutting refused frames again) is in neither but in the host's total.
+  double planSeconds() const { return planSeconds_; }
+  double collectSeconds() const { return collectSeconds_; }
+
+ private:
+  BinningModel device_;
+  TimedFrameDevice timed_;
+  BinningFrame frame_;
+  DeviceProfile profile_;
+  double simulationSeconds_ = 0, planSeconds_ = 0, collectSeconds_ = 0;
+  std::vector<Pair> pairs_;
+};
+
+/// One method per profile, named "accelerator binning on <profile>".
+std::vector<MethodSpec> binningMethods(const BinningParams& params, const std::vector<DeviceProfile>& profiles);
+
+}  // namespace bpaccel

@@ -1,0 +1,212 @@
+#include "binning_frame.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "../core/keys.hpp"
+
+namespace bpaccel {
+namespace {
+
+/// Inclusive float overlap: the same rule as overlaps() on keys.
+bool floatOverlaps(const Aabb& a, const Aabb& b) {
+  for (int k = 0; k < 3; ++k)
+    if (!(a.min[k] <= b.max[k] && b.min[k] <= a.max[k])) return false;
+  return true;
+}
+
+void checkBoxes(std::span<const Aabb> boxes) {
+  checkObjectCount(boxes.size());
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      if (std::isnan(boxes[i].min[a]) || std::isnan(boxes[i].max[a])) throw InputError(i, "NaN coordinate");
+      if (boxes[i].min[a] > boxes[i].max[a]) throw InputError(i, fmt::format("min above max on axis {}", a));
+    }
+}
+
+Pair ordered(std::uint32_t a, std::uint32_t b) { return a < b ? Pair{a, b} : Pair{b, a}; }
+
+}  // namespace
+
+void BinningFrame::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) {
+  plan(boxes);
+  send();
+  collect(out);
+}
+
+void BinningFrame::plan(std::span<const Aabb> boxes) {
+  checkBoxes(boxes);
+  boxes_ = boxes;
+  stats_ = {};
+  frames_.clear();
+  replies_.clear();
+  hostPairs_.clear();
+  longIds_.clear();
+  isLong_.assign(boxes.size(), 0);
+  const BinningParams& p = device_.params();
+  cellEdge_ = cellEdgeFor(p, boxes);
+  const double keys = std::ldexp(1.0, static_cast<int>(p.maxShift()));
+  std::vector<std::uint32_t> ids;
+  ids.reserve(boxes.size());
+  for (std::uint32_t i = 0; i < boxes.size(); ++i) {
+    bool fits = true;
+    for (int a = 0; a < 3; ++a)
+      fits = fits && (double{boxes[i].max[a]} - double{boxes[i].min[a]}) * keys / (keys - 4) <= cellEdge_[a];
+    if (fits) ids.push_back(i);
+    else longIds_.push_back(i), isLong_[i] = 1;
+  }
+  if (ids.size() <= p.boxCapacity) {
+    frames_.push_back(makeFrame(std::move(ids), 0, -HUGE_VAL, HUGE_VAL));
+    return;
+  }
+  // Slabs along the longest axis, cut at quantiles of the mins, about 90 % of the capacity each.
+  std::array<double, 3> lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (std::uint32_t i : ids)
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], double{boxes[i].min[a]}), hi[a] = std::max(hi[a], double{boxes[i].max[a]});
+  int axis = 0;
+  for (int a = 1; a < 3; ++a) axis = hi[a] - lo[a] > hi[axis] - lo[axis] ? a : axis;
+  const std::size_t slabs = (ids.size() + p.boxCapacity * 9 / 10 - 1) / (p.boxCapacity * 9 / 10);
+  std::vector<float> mins;
+  mins.reserve(ids.size());
+  for (std::uint32_t i : ids) mins.push_back(boxes[i].min[axis]);
+  // The cuts: the mins at the quantiles k / slabs, each found by a selection within the part above the last.
+  std::vector<double> cuts{-HUGE_VAL};
+  auto from = mins.begin();
+  for (std::size_t k = 1; k < slabs; ++k) {
+    const auto at = mins.begin() + static_cast<std::ptrdiff_t>(k * mins.size() / slabs);
+    std::nth_element(from, at, mins.end());
+    if (*at > cuts.back()) cuts.push_back(*at);
+    from = at;
+  }
+  cuts.push_back(HUGE_VAL);
+  // Each box into every slab its extent on the axis meets: [lo, hi) meets [min, max] when min < hi and max >= lo.
+  std::vector<std::vector<std::uint32_t>> parts(cuts.size() - 1);
+  for (std::uint32_t i : ids) {
+    const auto last = std::upper_bound(cuts.begin(), cuts.end(), double{boxes[i].max[axis]}) - cuts.begin() - 1;
+    for (auto k = std::lower_bound(cuts.begin() + 1, cuts.end(), double{boxes[i].min[axis]},
+                                   [](double cut, double m) { return cut <= m; }) - cuts.begin() - 1;
+         k <= last; ++k)
+      parts[static_cast<std::size_t>(k)].push_back(i);
+  }
+  for (std::size_t k = 0; k < parts.size(); ++k)
+    if (!parts[k].empty()) frames_.push_back(makeFrame(std::move(parts[k]), axis, cuts[k], cuts[k + 1]));
+}
+
+PlannedFrame BinningFrame::makeFrame(std::vector<std::uint32_t> ids, int axis, double lo, double hi) {
+  const BinningParams& p = device_.params();
+  PlannedFrame f;
+  f.axis = axis, f.lo = lo, f.hi = hi;
+  f.grid = pickGrid(p, boxes_, ids, cellEdge_);
+  f.keys.reserve(ids.size());
+  f.ids.reserve(ids.size());
+  for (std::uint32_t i : ids) {
+    const KeyBox k = quantize(f.grid, boxes_[i]);
+    if (fitsCells(f.grid, k)) {
+      f.ids.push_back(i);
+      f.keys.push_back(k);
+    } else if (!isLong_[i]) {  // by construction none; kept exact if rounding ever says otherwise
+      isLong_[i] = 1;
+      longIds_.push_back(i);
+    }
+  }
+  return f;
+}
+
+void BinningFrame::send() {
+  std::vector<PlannedFrame> todo(std::make_move_iterator(frames_.begin()), std::make_move_iterator(frames_.end()));
+  frames_.clear();
+  while (!todo.empty()) {
+    PlannedFrame f = std::move(todo.back());
+    todo.pop_back();
+    FrameCommand c{f.keys, f.grid.shift, f.grid.dims, std::nullopt};
+    FrameReply r = device_.runFrame(c);
+    stats_.deviceCycles += r.cycles;
+    stats_.boxesSent += f.ids.size();
+    if (r.error == FrameError::GroupOverflow || r.error == FrameError::CountOverCapacity) {
+      stats_.retries += 1;
+      if (!split(f, todo)) hostPairs(f);
+      continue;
+    }
+    if (r.error != FrameError::None)
+      throw std::logic_error(fmt::format("binning frame: the device refused a frame of the host's with {} at box {}",
+                                         frameErrorName(r.error), r.detail));
+    stats_.slabs += 1;
+    stats_.devicePairs += r.pairs.size();
+    stats_.issueCycles += r.issueCycles;
+    stats_.phases.intake += r.phases.intake, stats_.phases.prefix += r.phases.prefix;
+    stats_.phases.sort += r.phases.sort, stats_.phases.compute += r.phases.compute;
+    stats_.phases.drain += r.phases.drain;
+    frames_.push_back(std::move(f));
+    replies_.push_back(std::move(r));
+  }
+}
+
+void BinningFrame::decode(const PlannedFrame& f, const FrameReply& r, std::vector<Pair>& out) {
+  const bool slabbed = std::isfinite(f.lo) || std::isfinite(f.hi);
+  for (const auto& [li, lj] : r.pairs) {
+    const std::uint32_t i = f.ids.at(li), j = f.ids.at(lj);
+    const Aabb &a = boxes_[i], &b = boxes_[j];
+    if (!floatOverlaps(a, b)) {
+      stats_.falsePositives += 1;
+      continue;
+    }
+    const double corner = std::max(a.min[f.axis], b.min[f.axis]);
+    if (slabbed && !(corner >= f.lo && corner < f.hi)) {
+      stats_.boundaryDrops += 1;
+      continue;
+    }
+    out.push_back(ordered(i, j));
+  }
+}
+
+bool BinningFrame::split(const PlannedFrame& f, std::vector<PlannedFrame>& todo) {
+  // A slab is cut on its own axis (its pairs are owned along it); the whole scene on its longest.
+  int axis = f.axis;
+  if (!std::isfinite(f.lo) && !std::isfinite(f.hi)) {
+    std::array<double, 3> range{};
+    for (int a = 0; a < 3; ++a) range[a] = f.grid.unit[a] * f.grid.dims[a];
+    axis = static_cast<int>(std::max_element(range.begin(), range.end()) - range.begin());
+  }
+  std::vector<double> mins;
+  for (std::uint32_t i : f.ids) mins.push_back(boxes_[i].min[axis]);
+  std::nth_element(mins.begin(), mins.begin() + mins.size() / 2, mins.end());
+  const double cut = mins[mins.size() / 2];
+  if (!(cut > f.lo) || !(cut < f.hi)) return false;
+  for (auto [lo, hi] : {std::pair{f.lo, cut}, std::pair{cut, f.hi}}) {
+    std::vector<std::uint32_t> part;
+    for (std::uint32_t i : f.ids)
+      if (boxes_[i].min[axis] < hi && boxes_[i].max[axis] >= lo) part.push_back(i);
+    if (part.empty()) continue;
+    todo.push_back(makeFrame(std::move(part), axis, lo, hi));
+  }
+  return true;
+}
+
+void BinningFrame::hostPairs(const PlannedFrame& f) {
+  // A slab the device cannot hold and that cannot be cut: all its pairs on the host, its ownership rule kept.
+  for (std::size_t x = 0; x < f.ids.size(); ++x)
+    for (std::size_t y = x + 1; y < f.ids.size(); ++y) {
+      const Aabb &a = boxes_[f.ids[x]], &b = boxes_[f.ids[y]];
+      const double corner = std::max(a.min[f.axis], b.min[f.axis]);
+      if (floatOverlaps(a, b) && corner >= f.lo && corner < f.hi) hostPairs_.push_back(ordered(f.ids[x], f.ids[y]));
+    }
+}
+
+void BinningFrame::longBoxPairs(std::vector<Pair>& out) const {
+  for (std::uint32_t l : longIds_)
+    for (std::uint32_t i = 0; i < boxes_.size(); ++i)
+      if (i != l && (!isLong_[i] || i > l) && floatOverlaps(boxes_[l], boxes_[i])) out.push_back(ordered(l, i));
+}
+
+void BinningFrame::collect(std::vector<Pair>& out) {
+  out.clear();
+  for (std::size_t k = 0; k < frames_.size(); ++k) decode(frames_[k], replies_[k], out);
+  out.insert(out.end(), hostPairs_.begin(), hostPairs_.end());
+  longBoxPairs(out);
+  stats_.hostBoxes = longIds_.size();
+}
+
+}  // namespace bpaccel

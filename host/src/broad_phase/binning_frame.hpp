@@ -1,0 +1,91 @@
+#pragma once
+// The host's path to the binning device: each box sent once as narrow keys,
+// the device's global pairs decoded and rechecked with the float boxes.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "../core/types.hpp"
+#include "../device/binning/frame_device.hpp"
+#include "binning_grid.hpp"
+
+namespace bpaccel {
+
+/// What the last frame cost, counted as the device and the link would see it.
+struct BinningFrameStats {
+  std::size_t slabs = 0;           // device frames that returned pairs
+  std::size_t retries = 0;         // frames the device refused for room (then cut in two)
+  std::size_t boxesSent = 0;       // boxes over the link, summed over the frames sent
+  std::size_t hostBoxes = 0;       // boxes too long for the grid, tested on the host
+  std::size_t devicePairs = 0;     // pairs the device sent back
+  std::size_t falsePositives = 0;  // of them, dropped by the float recheck (quantization)
+  std::size_t boundaryDrops = 0;   // of them, owned by a neighbouring slab
+  std::uint64_t deviceCycles = 0;  // summed over the frames sent, refused ones too
+  std::uint64_t issueCycles = 0;
+  FramePhases phases;              // summed over the frames that returned pairs
+};
+
+/// One device frame of the plan: the boxes it carries (global ids, in stream
+/// order) with their keys, its grid, and the slab [lo, hi) on `axis` whose
+/// pairs it owns (a pair is owned where the low corner of its intersection lies).
+struct PlannedFrame {
+  std::vector<std::uint32_t> ids;
+  std::vector<KeyBox> keys;
+  KeyGrid grid;
+  int axis = 0;
+  double lo = -1.0 / 0.0, hi = 1.0 / 0.0;
+};
+
+/// Finds every overlapping pair of float boxes exactly once on a FrameDevice:
+/// - the grid: s = the largest shift, per axis a cell edge of at least the
+///   box extent all but ~n/256 boxes stay within (cellEdgeFor); boxes longer
+///   than that, or infinite, go to the host's exact path (each tested with
+///   every box), so the device never sees a box wider than two cells;
+/// - the keys: rounded outwards (quantize), so the device's pairs are a
+///   superset, and each is rechecked with the float boxes (inclusive, as
+///   overlaps() on keys);
+/// - slabs: a scene above the box capacity is cut along its longest axis at
+///   quantiles of the boxes' mins; a box meeting several slabs goes to each,
+///   and a pair is kept only by the slab holding its intersection's low
+///   corner on that axis. A frame the device refuses for room (GROUP_OVERFLOW,
+///   COUNT_OVER_CAPACITY) is cut in two and sent again; a slab that cannot be
+///   cut (all mins equal) is tested on the host.
+class BinningFrame {
+ public:
+  explicit BinningFrame(FrameDevice& device) : device_(device) {}
+  /// Appends the pairs (i < j) to `out` (cleared first). Throws InputError for a NaN or inverted box.
+  void findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out);
+  /// The steps of findPairs, for a caller that times them: plan (checks,
+  /// grid, keys, slabs), send (the frames to the device, and their replies
+  /// kept), collect (decode, recheck, the host's exact path). plan's boxes
+  /// are read until collect returns: they must stay alive and unchanged.
+  void plan(std::span<const Aabb> boxes);
+  void send();
+  void collect(std::vector<Pair>& out);
+  const BinningFrameStats& stats() const { return stats_; }
+  const std::vector<PlannedFrame>& frames() const { return frames_; }
+
+ private:
+  /// The frame of boxes `ids` owning [lo, hi) on `axis`, with its grid and keys; its too-long boxes go to hostIds_.
+  PlannedFrame makeFrame(std::vector<std::uint32_t> ids, int axis, double lo, double hi);
+  /// The frame's global pairs, kept where the float boxes overlap and the slab owns them.
+  void decode(const PlannedFrame& f, const FrameReply& r, std::vector<Pair>& out);
+  /// Cuts a refused frame in two at its boxes' median min; false if it cannot be cut.
+  bool split(const PlannedFrame& f, std::vector<PlannedFrame>& todo);
+  void hostPairs(const PlannedFrame& f);
+  void longBoxPairs(std::vector<Pair>& out) const;
+
+  FrameDevice& device_;
+  std::span<const Aabb> boxes_;
+  std::array<double, 3> cellEdge_{};
+  std::vector<PlannedFrame> frames_;
+  std::vector<FrameReply> replies_;  // send's, one per frame of frames_ that returned pairs
+  std::vector<std::uint32_t> longIds_;
+  std::vector<std::uint8_t> isLong_;
+  std::vector<Pair> hostPairs_;  // of slabs no cut could shrink
+  BinningFrameStats stats_;
+};
+
+}  // namespace bpaccel

@@ -1,0 +1,47 @@
+#pragma once
+// The host's half of a binning frame: float boxes to the device's narrow keys
+// on a grid the host picks, rounding outwards so no overlap is lost.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "../core/types.hpp"
+#include "../device/binning/binning_params.hpp"
+
+namespace bpaccel {
+
+/// One frame's grid: per axis an origin and a key unit (float units per key
+/// step), the shift s and the cells per axis. A cell is 2^s keys wide.
+struct KeyGrid {
+  std::array<double, 3> origin{};
+  std::array<double, 3> unit{1, 1, 1};
+  std::array<double, 3> scale{1, 1, 1};  // 1 / unit
+  std::array<double, 3> top{};           // the highest key: dims * 2^shift - 1, within the key width
+  unsigned shift = 0;
+  std::array<unsigned, 3> dims{1, 1, 1};
+};
+
+/// The grid for `ids` (boxes of `boxes`): s = the device's largest shift (the
+/// finest keys), and per axis the cell edge max(range / 2^cellBits,
+/// `cellEdge`), so a box no longer than that edge spans at most two cells.
+KeyGrid pickGrid(const BinningParams& p, std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
+                   const std::array<double, 3>& cellEdge);
+
+/// Box b's keys on `grid`: min rounded down, max up, clamped to the grid.
+/// Each step (float to double, subtract, multiply by the positive scale,
+/// clamp, round down or up) is monotone, so a <= b as floats gives key(a) <= key(b): overlapping boxes
+/// keep overlapping, and the device reports a superset of the pairs.
+KeyBox quantize(const KeyGrid& grid, const Aabb& b);
+
+/// Whether `key` covers at most two cells per axis (what the device takes).
+bool fitsCells(const KeyGrid& grid, const KeyBox& key);
+
+/// Per axis, the cell edge the grid must reach, with a margin for the keys'
+/// rounding: the longest finite extent, unless it is above twice the extent
+/// all but n / 256 boxes stay within (outliers); then twice that extent, and
+/// the longer boxes (at most n / 256 an axis) take the host's exact path.
+std::array<double, 3> cellEdgeFor(const BinningParams& p, std::span<const Aabb> boxes);
+
+}  // namespace bpaccel
