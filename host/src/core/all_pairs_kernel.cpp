@@ -27,8 +27,10 @@ constexpr std::int32_t kNeverMax = std::numeric_limits<std::int32_t>::min();
 
 std::int32_t signedKey(std::uint32_t key) { return static_cast<std::int32_t>(key ^ 0x80000000u); }
 
-// Pairs written without a capacity check each: room for a vector's worth is
-// made before each group (the vector doubles, so its zeroing is amortised).
+// Pairs written without a capacity check each: room for a group's worth is
+// made before each group, a chunk at a time. Only the chunk is zeroed: the
+// sink gives back what it did not use, so growing to twice the vector's size
+// would zero the whole vector again for every cell of a batch.
 class PairSink {
  public:
   explicit PairSink(std::vector<Pair>& out) : out_(out), used_(out.size()) {}
@@ -36,12 +38,13 @@ class PairSink {
   PairSink& operator=(const PairSink&) = delete;
   ~PairSink() { out_.resize(used_); }
   Pair* room(std::size_t k) {
-    if (out_.size() - used_ < k) out_.resize(std::max(used_ + k, 2 * out_.size()));
+    if (out_.size() - used_ < k) out_.resize(used_ + std::max(k, kChunk));
     return out_.data() + used_;
   }
   void advance(const Pair* to) { used_ = static_cast<std::size_t>(to - out_.data()); }
 
  private:
+  static constexpr std::size_t kChunk = 64;
   std::vector<Pair>& out_;
   std::size_t used_;
 };
