@@ -9,14 +9,6 @@
 #include "methods/timed_method.hpp"
 
 namespace bpaccel {
-namespace {
-
-bool overlap(const Aabb& a, const Aabb& b) {
-  return a.min[0] <= b.max[0] && b.min[0] <= a.max[0] && a.min[1] <= b.max[1] && b.min[1] <= a.max[1] &&
-         a.min[2] <= b.max[2] && b.min[2] <= a.max[2];
-}
-
-}  // namespace
 
 void sortAndSweepPairs(std::span<const Aabb> boxes, std::vector<Pair>& out, int axis) {
   out.clear();
@@ -28,7 +20,7 @@ void sortAndSweepPairs(std::span<const Aabb> boxes, std::vector<Pair>& out, int 
     const Aabb& a = boxes[order[s]];
     // Later boxes start at or after a's min; they overlap on the axis while they start by a's max.
     for (std::size_t t = s + 1; t < order.size() && boxes[order[t]].min[axis] <= a.max[axis]; ++t)
-      if (overlap(a, boxes[order[t]])) out.emplace_back(std::min(order[s], order[t]), std::max(order[s], order[t]));
+      if (overlaps(a, boxes[order[t]])) out.emplace_back(std::min(order[s], order[t]), std::max(order[s], order[t]));
   }
   std::sort(out.begin(), out.end());
 }
@@ -85,7 +77,7 @@ class MinCornerGrid {
 
   void pairs(std::vector<Pair>& out) const {
     const auto record = [&](std::uint32_t i, std::uint32_t j) {
-      if (overlap(boxes_[i], boxes_[j])) out.emplace_back(std::min(i, j), std::max(i, j));
+      if (overlaps(boxes_[i], boxes_[j])) out.emplace_back(std::min(i, j), std::max(i, j));
     };
     forEachCellPair([&](std::uint64_t c, std::uint64_t d) {
       for (std::uint32_t s = start_[c]; s < start_[c + 1]; ++s)

@@ -11,13 +11,6 @@
 namespace bpaccel {
 namespace {
 
-/// Inclusive float overlap: the same rule as overlaps() on keys.
-bool floatOverlaps(const Aabb& a, const Aabb& b) {
-  for (int k = 0; k < 3; ++k)
-    if (!(a.min[k] <= b.max[k] && b.min[k] <= a.max[k])) return false;
-  return true;
-}
-
 void checkBoxes(std::span<const Aabb> boxes) {
   checkObjectCount(boxes.size());
   for (std::size_t i = 0; i < boxes.size(); ++i)
@@ -149,7 +142,7 @@ void BinningFrame::decode(const PlannedFrame& f, const FrameReply& r, std::vecto
   for (const auto& [li, lj] : r.pairs) {
     const std::uint32_t i = f.ids.at(li), j = f.ids.at(lj);
     const Aabb &a = boxes_[i], &b = boxes_[j];
-    if (!floatOverlaps(a, b)) {
+    if (!overlaps(a, b)) {
       stats_.falsePositives += 1;
       continue;
     }
@@ -191,14 +184,14 @@ void BinningFrame::hostPairs(const PlannedFrame& f) {
     for (std::size_t y = x + 1; y < f.ids.size(); ++y) {
       const Aabb &a = boxes_[f.ids[x]], &b = boxes_[f.ids[y]];
       const double corner = std::max(a.min[f.axis], b.min[f.axis]);
-      if (floatOverlaps(a, b) && corner >= f.lo && corner < f.hi) hostPairs_.push_back(ordered(f.ids[x], f.ids[y]));
+      if (overlaps(a, b) && corner >= f.lo && corner < f.hi) hostPairs_.push_back(ordered(f.ids[x], f.ids[y]));
     }
 }
 
 void BinningFrame::longBoxPairs(std::vector<Pair>& out) const {
   for (std::uint32_t l : longIds_)
     for (std::uint32_t i = 0; i < boxes_.size(); ++i)
-      if (i != l && (!isLong_[i] || i > l) && floatOverlaps(boxes_[l], boxes_[i])) out.push_back(ordered(l, i));
+      if (i != l && (!isLong_[i] || i > l) && overlaps(boxes_[l], boxes_[i])) out.push_back(ordered(l, i));
 }
 
 void BinningFrame::collect(std::vector<Pair>& out) {

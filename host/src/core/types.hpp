@@ -33,6 +33,13 @@ inline bool overlaps(const KeyBox& a, const KeyBox& b) {
          a.min[2] <= b.max[2] && b.min[2] <= a.max[2];
 }
 
+/// The same on floats, as the host rechecks pairs: a NaN coordinate keeps boxes apart.
+inline bool overlaps(const Aabb& a, const Aabb& b) {
+  return a.min[0] <= b.max[0] && b.min[0] <= a.max[0] &&  //
+         a.min[1] <= b.max[1] && b.min[1] <= a.max[1] &&  //
+         a.min[2] <= b.max[2] && b.min[2] <= a.max[2];
+}
+
 /// The same without a branch: for loops over pairs whose outcome is hard to predict.
 inline bool overlapsBranchFree(const KeyBox& a, const KeyBox& b) {
   return static_cast<bool>((static_cast<unsigned>(a.min[0] <= b.max[0]) & static_cast<unsigned>(b.min[0] <= a.max[0])) &
