@@ -78,10 +78,12 @@ trait FormalChecks extends ChiselScalatestTester with Formal with Matchers { thi
     val printed = new ByteArrayOutputStream()
     val (e, s) = timed(Console.withOut(printed) {
       intercept[FailedBoundedCheckException] {
-        verify(
-          new FormalHarness(p.copy(faults = Set(fault)), Set(property)),
-          Seq(BoundedCheck(depth), FormalSolver.refuter, dir(s"mutant-${fault.toString}"))
-        )
+        FormalSolver.refuting { engine =>
+          verify(
+            new FormalHarness(p.copy(faults = Set(fault)), Set(property)),
+            Seq(BoundedCheck(depth), engine, dir(s"mutant-${fault.toString}"))
+          )
+        }
       }
     })
     val replay = printed.toString
