@@ -11,15 +11,6 @@
 namespace bpaccel {
 namespace {
 
-void checkBoxes(std::span<const Aabb> boxes) {
-  checkObjectCount(boxes.size());
-  for (std::size_t i = 0; i < boxes.size(); ++i)
-    for (int a = 0; a < 3; ++a) {
-      if (std::isnan(boxes[i].min[a]) || std::isnan(boxes[i].max[a])) throw InputError(i, "NaN coordinate");
-      if (boxes[i].min[a] > boxes[i].max[a]) throw InputError(i, fmt::format("min above max on axis {}", a));
-    }
-}
-
 Pair ordered(std::uint32_t a, std::uint32_t b) { return a < b ? Pair{a, b} : Pair{b, a}; }
 
 }  // namespace

@@ -61,17 +61,20 @@ bool isBad(const Aabb& b, const KeyBox& k) {
          static_cast<int>(k.min[2] > k.max[2]);
 }
 
-[[noreturn]] void throwFirstBad(std::span<const Aabb> boxes, std::span<const KeyBox> keys) {
+// The first bad coordinate of box i, named as the user wrote it; on the
+// keys, so that -ffast-math cannot fold the checks away.
+void checkBox(std::size_t i, const Aabb& b) {
   static constexpr const char* kAxis[3] = {"x", "y", "z"};
-  for (std::size_t i = 0; i < boxes.size(); ++i) {
-    const Aabb& b = boxes[i];
-    for (int a = 0; a < 3; ++a) {
-      if (isNaNBits(std::bit_cast<std::uint32_t>(b.min[a])) || isNaNBits(std::bit_cast<std::uint32_t>(b.max[a])))
-        throw InputError(i, fmt::format("NaN coordinate on axis {}", kAxis[a]));
-      if (keys[i].min[a] > keys[i].max[a])
-        throw InputError(i, fmt::format("min {} > max {} on axis {}", b.min[a], b.max[a], kAxis[a]));
-    }
+  for (int a = 0; a < 3; ++a) {
+    const auto lo = std::bit_cast<std::uint32_t>(b.min[a]), hi = std::bit_cast<std::uint32_t>(b.max[a]);
+    if (isNaNBits(lo) || isNaNBits(hi)) throw InputError(i, fmt::format("NaN coordinate on axis {}", kAxis[a]));
+    if (keyOfBits(lo) > keyOfBits(hi))
+      throw InputError(i, fmt::format("min {} > max {} on axis {}", b.min[a], b.max[a], kAxis[a]));
   }
+}
+
+[[noreturn]] void throwFirstBad(std::span<const Aabb> boxes) {
+  for (std::size_t i = 0; i < boxes.size(); ++i) checkBox(i, boxes[i]);
   throw std::logic_error("toKeys: a bad box was flagged but not found");
 }
 
@@ -281,10 +284,15 @@ void convert(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds* b
   checkObjectCount(boxes.size());
   out.resize(boxes.size());
   if (convertPart(boxes, out, bounds)) [[unlikely]]
-    throwFirstBad(boxes, out);
+    throwFirstBad(boxes);
 }
 
 }  // namespace
+
+void checkBoxes(std::span<const Aabb> boxes) {
+  checkObjectCount(boxes.size());
+  for (std::size_t i = 0; i < boxes.size(); ++i) checkBox(i, boxes[i]);
+}
 
 void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out) { convert(boxes, out, nullptr); }
 
@@ -313,7 +321,7 @@ void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds& bo
     }
   }
   if (bad) [[unlikely]]
-    throwFirstBad(boxes, out);
+    throwFirstBad(boxes);
 }
 
 KeyBounds boundsOf(std::span<const KeyBox> boxes) {

@@ -31,8 +31,13 @@ std::uint32_t floatToKey(float value);
 /// Largest number of objects one scene may hold: indices are 32-bit.
 constexpr std::uint64_t kMaxObjects = 0xFFFFFFFFull;
 
-/// Checks every box (no NaN, min <= max on every axis, count within kMaxObjects)
-/// and converts it to keys. Throws InputError for the first bad box; `out` is
+/// Checks every box: no NaN, min <= max on every axis (in key order, so -0.0
+/// equals +0.0, and on the bits, so -ffast-math cannot fold it away), count
+/// within kMaxObjects. Throws InputError for the first bad box, naming it, its
+/// axis and its values.
+void checkBoxes(std::span<const Aabb> boxes);
+
+/// Checks every box as checkBoxes does and converts it to keys. Throws InputError for the first bad box; `out` is
 /// reused across calls to avoid allocation.
 void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out);
 /// The same, and the scene's bounds found in the same pass (a partition that

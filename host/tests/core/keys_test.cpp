@@ -93,6 +93,7 @@ TEST(ToKeys, RejectsEveryBadFieldAtEveryPositionOfAGroupOfBoxes) {
           std::vector<KeyBox> keys;
           const std::string what = "n " + std::to_string(n) + " box " + std::to_string(at) + " axis " +
                                    std::to_string(a) + " kind " + std::to_string(kind);
+          std::string converting;
           try {
             toKeys(boxes, keys);
             ADD_FAILURE() << "accepted: " << what;
@@ -100,6 +101,14 @@ TEST(ToKeys, RejectsEveryBadFieldAtEveryPositionOfAGroupOfBoxes) {
             EXPECT_EQ(e.object(), at) << what;
             const std::string axis = std::string("axis ") + "xyz"[a];
             EXPECT_NE(std::string(e.what()).find(axis), std::string::npos) << what << ": " << e.what();
+            converting = e.what();
+          }
+          // The check alone refuses the same box with the same words.
+          try {
+            checkBoxes(boxes);
+            ADD_FAILURE() << "checkBoxes accepted: " << what;
+          } catch (const InputError& e) {
+            EXPECT_EQ(std::string(e.what()), converting) << what;
           }
         }
       }
@@ -109,6 +118,7 @@ TEST(ToKeys, RejectsEveryBadFieldAtEveryPositionOfAGroupOfBoxes) {
   std::vector<Aabb> good(5, Aabb{{-0.0f, 0, 1}, {0.0f, 0, 1}});
   std::vector<KeyBox> keys;
   EXPECT_NO_THROW(toKeys(good, keys));
+  EXPECT_NO_THROW(checkBoxes(good));
   EXPECT_EQ(keys[3].min[0], keys[3].max[0]);
 }
 
