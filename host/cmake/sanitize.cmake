@@ -3,8 +3,10 @@
 # UndefinedBehaviorSanitizer. Any report aborts (no recovery), so a finding
 # fails its test. libstdc++'s assertions add bounds checks to operator[].
 # -O1 keeps the build and the slow Verilated tests affordable; no NDEBUG.
+# -g1 (line tables) is what a report's stack trace reads, at two thirds of
+# -g's compile time.
 set(CMAKE_BUILD_TYPE Sanitize CACHE STRING "")
 set(CMAKE_CXX_FLAGS_SANITIZE
-    "-O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -D_GLIBCXX_ASSERTIONS"
+    "-O1 -g1 -fno-omit-frame-pointer -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -D_GLIBCXX_ASSERTIONS"
     CACHE STRING "")
 set(CMAKE_EXE_LINKER_FLAGS_SANITIZE "-fsanitize=address,undefined,float-cast-overflow" CACHE STRING "")
