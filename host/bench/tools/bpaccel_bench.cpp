@@ -173,7 +173,6 @@ int main(int argc, char** argv) {
   bpaccel::BenchConfig bench;
   bench.wholeStepObjects = 8000;
   bench.wholeStepRays = 500;
-  bench.queries.objectCounts = {8000, 100000};
   bench.manyWorlds.worlds = 4096;
   bpaccel::LineUpConfig lineUp;
   lineUp.cpuThreads = std::thread::hardware_concurrency();
@@ -260,9 +259,11 @@ int main(int argc, char** argv) {
   benchCmd->add_option("--whole-step-rays", bench.wholeStepRays,
                        "Broad-phase rayTests cast after each timed whole step, timed and every answer checked (0: none)")
       ->capture_default_str();
-  benchCmd->add_option("--query-objects", bench.queries.objectCounts,
+  std::vector<std::string> queryObjects = {"8000", "100000"};
+  benchCmd->add_option("--query-objects", queryObjects,
                        "Also time broad-phase rayTest and aabbTest, btDbvtBroadphase against bpaccel::BulletDropIn, "
                        "at these object counts (none: not)")
+      ->check(CLI::PositiveNumber | CLI::IsMember({"none"}))
       ->capture_default_str();
   benchCmd->add_option("--query-count", bench.queries.perKind, "Queries of each kind (two ray lengths, boxes) a round of the query table")
       ->check(CLI::PositiveNumber)->capture_default_str();
@@ -345,6 +346,9 @@ int main(int argc, char** argv) {
         bench.manyWorlds.device = lineUp.device;
         bench.manyWorlds.profiles = lineUp.profiles;
       }
+      bench.queries.objectCounts.clear();
+      for (const auto& n : queryObjects)
+        if (n != "none") bench.queries.objectCounts.push_back(std::stoull(n));
       return runBench(bench, lineUp, benchCells, benchJson);
     }
     if (*worldsCmd) {

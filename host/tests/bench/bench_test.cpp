@@ -747,6 +747,20 @@ TEST(BenchCli, NamesTheLinkUnitAndListsSkippedMethodsInTableAndJson) {
   std::filesystem::remove(json);
 }
 
+TEST(BenchCli, QueryObjectsNoneRunsNoQueryTableAndRefusesWhatIsNotACount) {
+  const auto json = std::filesystem::temp_directory_path() / ("bpaccel-noqueries-" + std::to_string(::getpid()) + ".json");
+  const std::string rest = "--objects 40 --frames 1 --warmup 0 --no-accelerator --cell-sizes 8 --many-worlds 0 "
+                           "--whole-step-objects 0 --json " + json.string();
+  const auto [code, table] = runBenchCli("--query-objects none " + rest);
+  EXPECT_EQ(code, 0) << table;
+  std::ifstream in(json);
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_FALSE(j.contains("queries"));
+  EXPECT_EQ(j["rows"].size(), 1u);
+  std::filesystem::remove(json);
+  for (const char* bad : {"0", "lots", "-5"}) EXPECT_NE(runBenchCli(std::string("--query-objects ") + bad + " " + rest).first, 0) << bad;
+}
+
 TEST(BenchCli, TheManyWorldsTableRunsInTheBenchAndAlone) {
   const auto json = std::filesystem::temp_directory_path() / ("bpaccel-worlds-" + std::to_string(::getpid()) + ".json");
   const auto [code, table] = runBenchCli("--worlds 8 --world-sizes 10 20 --world-frames 1 --world-warmup 0 --backend model "
