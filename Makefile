@@ -126,6 +126,25 @@ bench-run: host
 	$(PYTHON) scripts/plot_bench.py --json results/bench.json --out-dir results
 	$(HOST_BIN_DIR)/bpaccel-bench scene --objects 100 --frames 30 --out results/scene.json
 	$(PYTHON) scripts/render_scene.py --json results/scene.json --out results/scene.png
+	$(MAKE) bench-families-run BENCH_FAMILIES_OBJECTS=8000 BENCH_FAMILIES_DIR=results/families
+
+# The scene families unlike the bench's cube (docs/results.md, "Scene
+# families"): size variance, clusters, a flat world, long thin boxes, a layer
+# at one height. The software only (the cpu backend's rows against Bullet and
+# the peers), every frame validated. `make bench` runs each at 8000 objects
+# into results/families; this target at 1000, 8000 and 100,000 into
+# results/families-all.
+BENCH_FAMILIES         ?= sizes clusters flat poles layer
+BENCH_FAMILIES_OBJECTS ?= 1000 8000 100000
+BENCH_FAMILIES_DIR     ?= results/families-all
+BENCH_FAMILIES_ARGS    ?= --frames 10 --warmup 2 --no-accelerator --whole-step-objects 0 --many-worlds 0 --query-objects none
+.PHONY: bench-families bench-families-run
+bench-families: deps
+	$(MAKE) bench-families-run ARCH=$(BENCH_ARCH) M=$(BENCH_M) HOST_BIN_DIR=$(BENCH_BIN_DIR)
+
+bench-families-run: host
+	mkdir -p $(BENCH_FAMILIES_DIR); set -o pipefail; $(HOST_BIN_DIR)/bpaccel-bench run --families $(BENCH_FAMILIES) \
+	  --objects $(BENCH_FAMILIES_OBJECTS) $(BENCH_FAMILIES_ARGS) --json $(BENCH_FAMILIES_DIR)/bench.json | tee $(BENCH_FAMILIES_DIR)/bench.txt
 
 # The seed's sizes, 100,000 and 1,000,000 objects: device cycles from the
 # cycle-exact model backend (the Verilated one would take hours), every frame
