@@ -3,9 +3,8 @@
 # giving each part's time, so the budget stays in sight:
 #   make test: passed in 9m12s of the 10m00s budget: sbt 5m01s (fuzz 1m10s beside it), host 3m10s, fpga 1m15s
 # Each argument is a step, and the steps run one after the other. A step of
-# several parts joined by "+" runs them side by side (a part that needs
-# nothing from the others can use the cores the first leaves idle, such as
-# while sbt compiles): the first part's output streams, each other part's
+# several parts joined by "+" runs them side by side (for a part that needs
+# nothing from the others): the first part's output streams, each other part's
 # goes to build/test-parts/NAME.log and is printed when the step ends.
 # A failing part stops the run after its step, as make would, and the line
 # names it.
