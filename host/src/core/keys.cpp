@@ -74,7 +74,7 @@ void checkBox(std::size_t i, const Aabb& b) {
 }
 
 [[noreturn]] void throwFirstBad(std::span<const Aabb> boxes) {
-  for (std::size_t i = 0; i < boxes.size(); ++i) checkBox(i, boxes[i]);
+  checkBoxes(boxes);
   throw std::logic_error("toKeys: a bad box was flagged but not found");
 }
 

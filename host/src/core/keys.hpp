@@ -37,8 +37,9 @@ constexpr std::uint64_t kMaxObjects = 0xFFFFFFFFull;
 /// axis and its values.
 void checkBoxes(std::span<const Aabb> boxes);
 
-/// Checks every box as checkBoxes does and converts it to keys. Throws InputError for the first bad box; `out` is
-/// reused across calls to avoid allocation.
+/// Checks every box as checkBoxes does and converts it to keys. Throws
+/// InputError for the first bad box; `out` is reused across calls to avoid
+/// allocation.
 void toKeys(std::span<const Aabb> boxes, std::vector<KeyBox>& out);
 /// The same, and the scene's bounds found in the same pass (a partition that
 /// needs them then skips a pass of its own over the keys).
