@@ -212,7 +212,19 @@ int main(int argc, char** argv) {
   benchCmd->add_flag("--accelerator,!--no-accelerator", accelerator,
                      "Run the accelerator's rows (a Verilated or modelled device beside the software)")
       ->capture_default_str();
-  benchCmd->add_option("--cell-sizes", benchCells, "k-d tree cell sizes ('none' = no tree)")->capture_default_str();
+  // A positive integer or 'none', as parseCellSize reads it; refused at parse time, naming the option.
+  const CLI::Validator positiveOrNone(
+      [](std::string& text) -> std::string {
+        try {
+          bpaccel::parseCellSize(text);
+          return "";
+        } catch (const std::invalid_argument& e) {
+          return e.what();
+        }
+      },
+      "UINT|none");
+  benchCmd->add_option("--cell-sizes", benchCells, "k-d tree cell sizes ('none' = no tree)")
+      ->check(positiveOrNone)->capture_default_str();
   benchCmd->add_option("--grid-cell-sizes", lineUp.gridCellSizes,
                        "Cell sizes of the extra 'accelerator grid C' and 'cpu grid C' rows (uniform grid partition)")
       ->check(CLI::PositiveNumber)
@@ -263,8 +275,7 @@ int main(int argc, char** argv) {
   benchCmd->add_option("--query-objects", queryObjects,
                        "Also time broad-phase rayTest and aabbTest, btDbvtBroadphase against bpaccel::BulletDropIn, "
                        "at these object counts (none: not)")
-      ->check(CLI::PositiveNumber | CLI::IsMember({"none"}))
-      ->capture_default_str();
+      ->check(positiveOrNone)->capture_default_str();
   benchCmd->add_option("--query-count", bench.queries.perKind, "Queries of each kind (two ray lengths, boxes) a round of the query table")
       ->check(CLI::PositiveNumber)->capture_default_str();
   const auto addWorldsOptions = [](CLI::App* cmd, bpaccel::ManyWorldsBenchConfig& w) {
@@ -348,7 +359,7 @@ int main(int argc, char** argv) {
       }
       bench.queries.objectCounts.clear();
       for (const auto& n : queryObjects)
-        if (n != "none") bench.queries.objectCounts.push_back(std::stoull(n));
+        if (const auto count = bpaccel::parseCellSize(n)) bench.queries.objectCounts.push_back(*count);
       return runBench(bench, lineUp, benchCells, benchJson);
     }
     if (*worldsCmd) {

@@ -758,7 +758,8 @@ TEST(BenchCli, QueryObjectsNoneRunsNoQueryTableAndRefusesWhatIsNotACount) {
   EXPECT_FALSE(j.contains("queries"));
   EXPECT_EQ(j["rows"].size(), 1u);
   std::filesystem::remove(json);
-  for (const char* bad : {"0", "lots", "-5"}) EXPECT_NE(runBenchCli(std::string("--query-objects ") + bad + " " + rest).first, 0) << bad;
+  for (const char* bad : {"0", "lots", "-5", "5.5", "1e5"})
+    EXPECT_NE(runBenchCli(std::string("--query-objects ") + bad + " " + rest).first, 0) << bad;
 }
 
 TEST(BenchCli, TheManyWorldsTableRunsInTheBenchAndAlone) {
