@@ -69,11 +69,9 @@ deps:
 	@./scripts/deps.sh
 
 # Every test of the project, part by part; the last line gives each part's
-# time against the 10-minute budget (scripts/test_parts.sh). The fuzz part
-# needs nothing sbt makes, so it runs beside sbt (the two share the cores:
-# measured, this saves only seconds, since sbt keeps both busy).
+# time against the 10-minute budget (scripts/test_parts.sh).
 test: deps
-	@MAKE="$(MAKE)" scripts/test_parts.sh sbt=test-hw+fuzz=test-fuzz host=test-host fpga=test-fpga
+	@MAKE="$(MAKE)" scripts/test_parts.sh sbt=test-hw host=test-host fpga=test-fpga fuzz=test-fuzz
 
 # The Chisel generator: golden model, ChiselTest (Scala simulator and Verilator),
 # Verilog lint and memory structure. The same sbt session then emits the
