@@ -31,7 +31,7 @@ lazy val root = (project in file("."))
     concurrentRestrictions in Global += Tags.limit(Tags.Test, 2),
     Test / fork := true,
     Test / javaOptions ++= Seq("-Xmx6g", "-Xss16m"),
-    // The formal checks' z3 (scripts/deps.sh installs it there) before any other.
+    // The formal checks' solvers, Yices and z3 (scripts/deps.sh installs them there), before any other.
     Test / envVars += "PATH" -> s"${(baseDirectory.value / "build" / "formal-tools" / "bin").getAbsolutePath}:${sys.env.getOrElse("PATH", "")}",
     // Each Verilator-backed configuration compiles Verilator's runtime (about
     // 8 of a small model's 11 s); through ccache (scripts/deps.sh installs it)
