@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -25,37 +26,65 @@ void BinningFrame::plan(std::span<const Aabb> boxes) {
   checkBoxes(boxes);
   boxes_ = boxes;
   stats_ = {};
+  for (PlannedFrame& f : frames_) spare_.push_back(std::move(f));  // their buffers, for this frame's
   frames_.clear();
   replies_.clear();
   hostPairs_.clear();
   longIds_.clear();
   isLong_.assign(boxes.size(), 0);
   const BinningParams& p = device_.params();
-  cellEdge_ = cellEdgeFor(p, boxes);
-  const double keys = std::ldexp(1.0, static_cast<int>(p.maxShift()));
-  std::vector<std::uint32_t> ids;
-  ids.reserve(boxes.size());
-  for (std::uint32_t i = 0; i < boxes.size(); ++i) {
-    bool fits = true;
-    for (int a = 0; a < 3; ++a)
-      fits = fits && (double{boxes[i].max[a]} - double{boxes[i].min[a]}) * keys / (keys - 4) <= cellEdge_[a];
-    if (fits) ids.push_back(i);
-    else longIds_.push_back(i), isLong_[i] = 1;
+  const ExtentSurvey survey = surveyExtents(p, boxes);
+  cellEdge_ = survey.cellEdge;
+  PlannedFrame whole = takeSpare();
+  AxisBounds bounds = survey.bounds;
+  if (survey.allWithin) {
+    whole.ids.resize(boxes.size());
+    std::iota(whole.ids.begin(), whole.ids.end(), 0u);
+  } else {
+    bounds = keepFitting(whole.ids);
   }
-  if (ids.size() <= p.boxCapacity) {
-    frames_.push_back(makeFrame(std::move(ids), 0, -HUGE_VAL, HUGE_VAL));
+  if (whole.ids.size() <= p.boxCapacity) {  // the common frame: one device frame
+    whole.grid = gridFor(p, bounds, cellEdge_);
+    frames_.push_back(std::move(whole));
+    fillKeys(frames_.back(), 0, -HUGE_VAL, HUGE_VAL);
     return;
   }
+  planSlabs(whole.ids, bounds);
+  spare_.push_back(std::move(whole));
+}
+
+AxisBounds BinningFrame::keepFitting(std::vector<std::uint32_t>& ids) {
+  // A box fits when its extent, widened by the keys' rounding as surveyExtents widens, is within the cell
+  // edge (fitsCells on its keys decides; this sends the longer boxes to the host's path early). Most boxes
+  // are well within: a multiplication tells, and the division runs for the few near the edge.
+  const double keys = std::ldexp(1.0, static_cast<int>(device_.params().maxShift()));
+  std::array<double, 3> within{};
+  for (int a = 0; a < 3; ++a) within[a] = cellEdge_[a] * (keys - 8) / keys;
+  const auto fits = [&](double e, int a) { return e <= within[a] || e * keys / (keys - 4) <= cellEdge_[a]; };
+  ids.clear();
+  AxisBounds bounds;
+  for (std::uint32_t i = 0; i < boxes_.size(); ++i) {
+    const Aabb& b = boxes_[i];
+    if (fits(double{b.max[0]} - double{b.min[0]}, 0) && fits(double{b.max[1]} - double{b.min[1]}, 1) &&
+        fits(double{b.max[2]} - double{b.min[2]}, 2)) {
+      ids.push_back(i);
+      bounds.add(b);
+    } else {
+      longIds_.push_back(i), isLong_[i] = 1;
+    }
+  }
+  return bounds;
+}
+
+void BinningFrame::planSlabs(std::span<const std::uint32_t> ids, const AxisBounds& bounds) {
   // Slabs along the longest axis, cut at quantiles of the mins, about 90 % of the capacity each.
-  std::array<double, 3> lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  for (std::uint32_t i : ids)
-    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], double{boxes[i].min[a]}), hi[a] = std::max(hi[a], double{boxes[i].max[a]});
+  const BinningParams& p = device_.params();
   int axis = 0;
-  for (int a = 1; a < 3; ++a) axis = hi[a] - lo[a] > hi[axis] - lo[axis] ? a : axis;
+  for (int a = 1; a < 3; ++a) axis = bounds.hi[a] - bounds.lo[a] > bounds.hi[axis] - bounds.lo[axis] ? a : axis;
   const std::size_t slabs = (ids.size() + p.boxCapacity * 9 / 10 - 1) / (p.boxCapacity * 9 / 10);
   std::vector<float> mins;
   mins.reserve(ids.size());
-  for (std::uint32_t i : ids) mins.push_back(boxes[i].min[axis]);
+  for (std::uint32_t i : ids) mins.push_back(boxes_[i].min[axis]);
   // The cuts: the mins at the quantiles k / slabs, each found by a selection within the part above the last.
   std::vector<double> cuts{-HUGE_VAL};
   auto from = mins.begin();
@@ -69,8 +98,8 @@ void BinningFrame::plan(std::span<const Aabb> boxes) {
   // Each box into every slab its extent on the axis meets: [lo, hi) meets [min, max] when min < hi and max >= lo.
   std::vector<std::vector<std::uint32_t>> parts(cuts.size() - 1);
   for (std::uint32_t i : ids) {
-    const auto last = std::upper_bound(cuts.begin(), cuts.end(), double{boxes[i].max[axis]}) - cuts.begin() - 1;
-    for (auto k = std::lower_bound(cuts.begin() + 1, cuts.end(), double{boxes[i].min[axis]},
+    const auto last = std::upper_bound(cuts.begin(), cuts.end(), double{boxes_[i].max[axis]}) - cuts.begin() - 1;
+    for (auto k = std::lower_bound(cuts.begin() + 1, cuts.end(), double{boxes_[i].min[axis]},
                                    [](double cut, double m) { return cut <= m; }) - cuts.begin() - 1;
          k <= last; ++k)
       parts[static_cast<std::size_t>(k)].push_back(i);
@@ -79,24 +108,42 @@ void BinningFrame::plan(std::span<const Aabb> boxes) {
     if (!parts[k].empty()) frames_.push_back(makeFrame(std::move(parts[k]), axis, cuts[k], cuts[k + 1]));
 }
 
+PlannedFrame BinningFrame::takeSpare() {
+  if (spare_.empty()) return {};
+  PlannedFrame f = std::move(spare_.back());
+  spare_.pop_back();
+  return f;
+}
+
 PlannedFrame BinningFrame::makeFrame(std::vector<std::uint32_t> ids, int axis, double lo, double hi) {
-  const BinningParams& p = device_.params();
-  PlannedFrame f;
+  PlannedFrame f = takeSpare();
+  f.grid = pickGrid(device_.params(), boxes_, ids, cellEdge_);
+  f.ids = std::move(ids);
+  fillKeys(f, axis, lo, hi);
+  return f;
+}
+
+void BinningFrame::fillKeys(PlannedFrame& f, int axis, double lo, double hi) {
   f.axis = axis, f.lo = lo, f.hi = hi;
-  f.grid = pickGrid(p, boxes_, ids, cellEdge_);
-  f.keys.reserve(ids.size());
-  f.ids.reserve(ids.size());
-  for (std::uint32_t i : ids) {
-    const KeyBox k = quantize(f.grid, boxes_[i]);
-    if (fitsCells(f.grid, k)) {
-      f.ids.push_back(i);
-      f.keys.push_back(k);
-    } else if (!isLong_[i]) {  // by construction none; kept exact if rounding ever says otherwise
-      isLong_[i] = 1;
-      longIds_.push_back(i);
+  f.keys.resize(f.ids.size());
+  quantizeAll(f.grid, boxes_, f.ids, f.keys);
+  bool allFit = true;
+  for (const KeyBox& k : f.keys) allFit &= fitsCells(f.grid, k);
+  if (allFit) [[likely]]
+    return;
+  // By construction no box spans more than two cells; should rounding ever say otherwise, the box is the host's.
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < f.ids.size(); ++k) {
+    if (fitsCells(f.grid, f.keys[k])) {
+      f.ids[n] = f.ids[k];
+      f.keys[n++] = f.keys[k];
+    } else if (!isLong_[f.ids[k]]) {
+      isLong_[f.ids[k]] = 1;
+      longIds_.push_back(f.ids[k]);
     }
   }
-  return f;
+  f.ids.resize(n);
+  f.keys.resize(n);
 }
 
 void BinningFrame::send() {
@@ -130,7 +177,15 @@ void BinningFrame::send() {
 
 void BinningFrame::decode(const PlannedFrame& f, const FrameReply& r, std::vector<Pair>& out) {
   const bool slabbed = std::isfinite(f.lo) || std::isfinite(f.hi);
-  for (const auto& [li, lj] : r.pairs) {
+  // The pairs come in the device's order, so the boxes are read at random: each read is asked for a few pairs ahead.
+  constexpr std::size_t kAhead = 16;
+  const std::size_t n = f.ids.size();
+  for (std::size_t k = 0; k < r.pairs.size(); ++k) {
+    if (k + kAhead < r.pairs.size()) {
+      const auto [pi, pj] = r.pairs[k + kAhead];
+      if (pi < n && pj < n) __builtin_prefetch(&boxes_[f.ids[pi]]), __builtin_prefetch(&boxes_[f.ids[pj]]);
+    }
+    const auto [li, lj] = r.pairs[k];
     const std::uint32_t i = f.ids.at(li), j = f.ids.at(lj);
     const Aabb &a = boxes_[i], &b = boxes_[j];
     if (!overlaps(a, b)) {

@@ -40,7 +40,7 @@ struct PlannedFrame {
 
 /// Finds every overlapping pair of float boxes exactly once on a FrameDevice:
 /// - the grid: s = the largest shift, per axis a cell edge of at least the
-///   box extent all but ~n/256 boxes stay within (cellEdgeFor); boxes longer
+///   box extent all but ~n/256 boxes stay within (surveyExtents); boxes longer
 ///   than that, or infinite, go to the host's exact path (each tested with
 ///   every box), so the device never sees a box wider than two cells;
 /// - the keys: rounded outwards (quantize), so the device's pairs are a
@@ -68,8 +68,16 @@ class BinningFrame {
   const std::vector<PlannedFrame>& frames() const { return frames_; }
 
  private:
-  /// The frame of boxes `ids` owning [lo, hi) on `axis`, with its grid and keys; its too-long boxes go to hostIds_.
+  /// The boxes within the cell edge into `ids`, the others to the host's path; returns the bounds of `ids`.
+  AxisBounds keepFitting(std::vector<std::uint32_t>& ids);
+  /// Cuts the scene's fitting boxes `ids` (within `bounds`) into slabs, each a frame of frames_.
+  void planSlabs(std::span<const std::uint32_t> ids, const AxisBounds& bounds);
+  /// A frame of spare_, its buffers' capacity kept from an earlier frame, or a new one.
+  PlannedFrame takeSpare();
+  /// The frame of boxes `ids` owning [lo, hi) on `axis`, with its grid and keys.
   PlannedFrame makeFrame(std::vector<std::uint32_t> ids, int axis, double lo, double hi);
+  /// f's keys on its grid, for its ids; a box whose keys span more than two cells goes to the host's path.
+  void fillKeys(PlannedFrame& f, int axis, double lo, double hi);
   /// The frame's global pairs, kept where the float boxes overlap and the slab owns them.
   void decode(const PlannedFrame& f, const FrameReply& r, std::vector<Pair>& out);
   /// Cuts a refused frame in two at its boxes' median min; false if it cannot be cut.
@@ -81,6 +89,7 @@ class BinningFrame {
   std::span<const Aabb> boxes_;
   std::array<double, 3> cellEdge_{};
   std::vector<PlannedFrame> frames_;
+  std::vector<PlannedFrame> spare_;  // frames of earlier calls, whose buffers the next frames reuse
   std::vector<FrameReply> replies_;  // send's, one per frame of frames_ that returned pairs
   std::vector<std::uint32_t> longIds_;
   std::vector<std::uint8_t> isLong_;

@@ -2,60 +2,171 @@
 
 #include <algorithm>
 #include <bit>
-#include <memory>
 #include <cmath>
 #include <limits>
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
+#include "../core/cpu_features.hpp"
 
 namespace bpaccel {
 
 namespace {
 
-/// Per axis, a histogram of the finite extents by binary exponent, with each bucket's longest.
-struct ExtentHistogram {
-  static constexpr int kBuckets = 2047;  // the exponent field of a finite double
-  std::array<std::array<std::uint32_t, kBuckets>, 3> count{};
-  std::array<std::array<double, kBuckets>, 3> longest{};
-  std::size_t finite = 0;
-};
-
 int exponentOf(double e) { return static_cast<int>((std::bit_cast<std::uint64_t>(e) >> 52) & 0x7ff); }
+constexpr int kNotFinite = 0x7ff;  // the exponent field of an infinite or NaN double
 
 }  // namespace
 
-std::array<double, 3> cellEdgeFor(const BinningParams& p, std::span<const Aabb> boxes) {
-  auto h = std::make_unique<ExtentHistogram>();
-  for (const Aabb& b : boxes)
+namespace {
+
+/// A frame's extents in brief: per axis the longest finite extent, the bounds, how many extents are infinite
+/// or NaN, and how many lie within the longest one's binary exponent or the one below (its top buckets).
+struct ExtentBrief {
+  std::array<double, 3> longest{};
+  AxisBounds bounds;
+  std::array<std::size_t, 3> notFinite{}, top{};
+};
+
+/// The lowest extent of the top buckets: 2^(x - 1) for the longest's binary exponent x; 0 if there is none.
+double topFloor(double longest) {
+  const int x = exponentOf(longest);
+  return x >= 2 ? std::bit_cast<double>(static_cast<std::uint64_t>(x - 1) << 52) : 0.0;
+}
+
+void briefScalar(std::span<const Aabb> boxes, std::size_t from, ExtentBrief& brief) {
+  for (std::size_t i = from; i < boxes.size(); ++i) {
     for (int a = 0; a < 3; ++a) {
-      const double e = double{b.max[a]} - double{b.min[a]};
-      const int x = exponentOf(e);
-      if (x >= ExtentHistogram::kBuckets) continue;  // infinite or NaN: the host's
-      h->count[a][x] += 1;
-      h->longest[a][x] = std::max(h->longest[a][x], e);
+      const double e = double{boxes[i].max[a]} - double{boxes[i].min[a]};
+      const bool finite = exponentOf(e) != kNotFinite;
+      brief.longest[a] = std::max(brief.longest[a], finite ? e : 0.0);
+      brief.notFinite[a] += !finite;
     }
+    brief.bounds.add(boxes[i]);
+  }
+}
+
+#if defined(__x86_64__)
+// The brief's first pass four lanes at a time: a box's mins (and its max x) in one vector, its maxes (and
+// the next box's min x) in another, so lanes 0-2 are its axes; the last box is left to the scalar loop.
+__attribute__((target("avx2"))) std::size_t briefAvx2(std::span<const Aabb> boxes, ExtentBrief& brief) {
+  if (boxes.size() < 2) return 0;
+  const __m256d infinity = _mm256_set1_pd(HUGE_VAL), one = _mm256_set1_pd(1);
+  __m256d longest = _mm256_setzero_pd(), notFinite = _mm256_setzero_pd();
+  __m256d lo = infinity, hi = _mm256_set1_pd(-HUGE_VAL);
+  const std::size_t last = boxes.size() - 1;
+  for (std::size_t i = 0; i < last; ++i) {
+    const __m256d mins = _mm256_cvtps_pd(_mm_loadu_ps(&boxes[i].min[0]));
+    const __m256d maxs = _mm256_cvtps_pd(_mm_loadu_ps(&boxes[i].max[0]));
+    const __m256d e = _mm256_sub_pd(maxs, mins);
+    const __m256d finite = _mm256_cmp_pd(e, infinity, _CMP_LT_OQ);
+    longest = _mm256_max_pd(longest, _mm256_and_pd(finite, e));
+    notFinite = _mm256_add_pd(notFinite, _mm256_andnot_pd(finite, one));
+    lo = _mm256_min_pd(lo, mins), hi = _mm256_max_pd(hi, maxs);
+  }
+  alignas(32) std::array<double, 4> l, n, b0, b1;
+  _mm256_store_pd(l.data(), longest), _mm256_store_pd(n.data(), notFinite);
+  _mm256_store_pd(b0.data(), lo), _mm256_store_pd(b1.data(), hi);
+  for (int a = 0; a < 3; ++a) {
+    brief.longest[a] = std::max(brief.longest[a], l[a]);
+    brief.notFinite[a] += static_cast<std::size_t>(n[a]);
+    brief.bounds.lo[a] = std::min(brief.bounds.lo[a], b0[a]), brief.bounds.hi[a] = std::max(brief.bounds.hi[a], b1[a]);
+  }
+  return last;
+}
+
+// The second pass: how many extents reach each axis's top floor.
+__attribute__((target("avx2"))) std::size_t topAvx2(std::span<const Aabb> boxes, ExtentBrief& brief) {
+  if (boxes.size() < 2) return 0;
+  const __m256d floor = _mm256_setr_pd(topFloor(brief.longest[0]), topFloor(brief.longest[1]),
+                                       topFloor(brief.longest[2]), HUGE_VAL);
+  const __m256d one = _mm256_set1_pd(1);
+  __m256d top = _mm256_setzero_pd();
+  const std::size_t last = boxes.size() - 1;
+  for (std::size_t i = 0; i < last; ++i) {
+    const __m256d e = _mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(&boxes[i].max[0])),
+                                    _mm256_cvtps_pd(_mm_loadu_ps(&boxes[i].min[0])));
+    top = _mm256_add_pd(top, _mm256_and_pd(_mm256_cmp_pd(e, floor, _CMP_GE_OQ), one));
+  }
+  alignas(32) std::array<double, 4> t;
+  _mm256_store_pd(t.data(), top);
+  for (int a = 0; a < 3; ++a) brief.top[a] += static_cast<std::size_t>(t[a]);
+  return last;
+}
+#endif
+
+ExtentBrief briefOf(std::span<const Aabb> boxes) {
+  ExtentBrief brief;
+  std::size_t from = 0, topFrom = 0;
+#if defined(__x86_64__)
+  if (cpuHasAvx2()) from = briefAvx2(boxes, brief);
+#endif
+  briefScalar(boxes, from, brief);
+#if defined(__x86_64__)
+  if (cpuHasAvx2()) topFrom = topAvx2(boxes, brief);
+#endif
+  for (std::size_t i = topFrom; i < boxes.size(); ++i)
+    for (int a = 0; a < 3; ++a)
+      brief.top[a] += double{boxes[i].max[a]} - double{boxes[i].min[a]} >= topFloor(brief.longest[a]);
+  return brief;
+}
+
+}  // namespace
+
+ExtentSurvey surveyExtents(const BinningParams& p, std::span<const Aabb> boxes) {
   const std::size_t outliers = boxes.size() / 256;
   const double keys = std::ldexp(1.0, static_cast<int>(p.maxShift()));
-  std::array<double, 3> edge{};
+  ExtentSurvey survey;
+  // The common frame: every extent finite, and more than the outliers in the longest's top buckets, so the
+  // (outliers + 1)-th longest is there too and no extent is an outlier: the brief's two vector passes tell.
+  const ExtentBrief brief = briefOf(boxes);
+  bool common = true;
+  for (int a = 0; a < 3; ++a) common = common && brief.notFinite[a] == 0 && brief.top[a] > outliers && topFloor(brief.longest[a]) > 0;
+  if (common) {
+    survey.bounds = brief.bounds;
+    survey.allWithin = true;
+    // A box of e spans at most e / unit + 2 keys after the outward rounding; 2^s keys make a cell.
+    for (int a = 0; a < 3; ++a) survey.cellEdge[a] = brief.longest[a] * keys / (keys - 4);
+    return survey;
+  }
+  // Otherwise per axis a count of the extents by binary exponent, to find the outliers.
+  std::array<std::array<std::uint32_t, kNotFinite + 1>, 3> count{};
+  for (const Aabb& b : boxes)
+    for (int a = 0; a < 3; ++a) count[a][exponentOf(double{b.max[a]} - double{b.min[a]})] += 1;
+  survey.bounds = brief.bounds;
+  survey.allWithin = true;
   for (int a = 0; a < 3; ++a) {
     // The bucket of the (outliers + 1)-th longest extent; the buckets more than one above it are outliers.
     std::size_t seen = 0;
-    int q = ExtentHistogram::kBuckets - 1;
-    for (; q > 0 && seen + h->count[a][q] <= outliers; --q) seen += h->count[a][q];
-    double reach = 0;
-    for (int x = 0; x <= std::min(q + 1, ExtentHistogram::kBuckets - 1); ++x) reach = std::max(reach, h->longest[a][x]);
-    // A box of e spans at most e / unit + 2 keys after the outward rounding; 2^s keys make a cell.
-    edge[a] = reach * keys / (keys - 4);
+    int q = kNotFinite - 1;
+    for (; q > 0 && seen + count[a][q] <= outliers; --q) seen += count[a][q];
+    double reach = brief.longest[a];
+    if (exponentOf(reach) > q + 1) {  // outliers: the longest extent below them, in a second pass
+      reach = 0;
+      for (const Aabb& b : boxes) {
+        const double e = double{b.max[a]} - double{b.min[a]};
+        reach = std::max(reach, exponentOf(e) <= q + 1 ? e : 0.0);
+      }
+      survey.allWithin = false;
+    }
+    survey.allWithin = survey.allWithin && count[a][kNotFinite] == 0;
+    survey.cellEdge[a] = reach * keys / (keys - 4);
   }
-  return edge;
+  return survey;
 }
 
-KeyGrid pickGrid(const BinningParams& p, std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
-                   const std::array<double, 3>& cellEdge) {
+void AxisBounds::add(const Aabb& b) {
+  for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], double{b.min[a]}), hi[a] = std::max(hi[a], double{b.max[a]});
+}
+
+KeyGrid gridFor(const BinningParams& p, const AxisBounds& bounds, const std::array<double, 3>& cellEdge) {
   KeyGrid g;
   g.shift = p.maxShift();
   const double keysPerCell = std::ldexp(1.0, static_cast<int>(g.shift));
   for (int a = 0; a < 3; ++a) {
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (std::uint32_t i : ids) lo = std::min(lo, double{boxes[i].min[a]}), hi = std::max(hi, double{boxes[i].max[a]});
+    double lo = bounds.lo[a], hi = bounds.hi[a];
     if (!(hi >= lo)) lo = hi = 0;  // no boxes
     const double range = hi - lo;
     double edge = std::max(range / p.maxDim(), cellEdge[a]);
@@ -70,6 +181,13 @@ KeyGrid pickGrid(const BinningParams& p, std::span<const Aabb> boxes, std::span<
   return g;
 }
 
+KeyGrid pickGrid(const BinningParams& p, std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
+                 const std::array<double, 3>& cellEdge) {
+  AxisBounds bounds;
+  for (std::uint32_t i : ids) bounds.add(boxes[i]);
+  return gridFor(p, bounds, cellEdge);
+}
+
 KeyBox quantize(const KeyGrid& grid, const Aabb& b) {
   KeyBox k;
   for (int a = 0; a < 3; ++a) {
@@ -81,6 +199,51 @@ KeyBox quantize(const KeyGrid& grid, const Aabb& b) {
     k.max[a] = h + (static_cast<double>(h) < hi);
   }
   return k;
+}
+
+namespace {
+
+#if defined(__x86_64__)
+// quantize's arithmetic, lane for lane the same IEEE operations (convert, subtract, multiply, clamp, floor;
+// a max lane adds one where the floor is below the value), so the keys are the scalar loop's bit for bit:
+// min x, y, z and max x in one AVX vector, max y and z in an SSE2 one. Keys must fit an int32 (the
+// conversion is signed): the caller checks top. No lambdas: they would not inherit the target attribute.
+__attribute__((target("avx2"))) void quantizeAvx2(const KeyGrid& g, std::span<const Aabb> boxes,
+                                                 std::span<const std::uint32_t> ids, std::span<KeyBox> keys) {
+  const __m256d origin = _mm256_setr_pd(g.origin[0], g.origin[1], g.origin[2], g.origin[0]);
+  const __m256d scale = _mm256_setr_pd(g.scale[0], g.scale[1], g.scale[2], g.scale[0]);
+  const __m256d top = _mm256_setr_pd(g.top[0], g.top[1], g.top[2], g.top[0]);
+  const __m256d upLane = _mm256_setr_pd(0, 0, 0, 1);  // lane 3 is a max: rounded up
+  const __m128d origin2 = _mm_setr_pd(g.origin[1], g.origin[2]), scale2 = _mm_setr_pd(g.scale[1], g.scale[2]);
+  const __m128d top2 = _mm_setr_pd(g.top[1], g.top[2]), one2 = _mm_set1_pd(1);
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const Aabb& b = boxes[ids[k]];
+    __m256d v = _mm256_cvtps_pd(_mm_loadu_ps(&b.min[0]));
+    v = _mm256_min_pd(_mm256_max_pd(_mm256_mul_pd(_mm256_sub_pd(v, origin), scale), _mm256_setzero_pd()), top);
+    const __m256d down = _mm256_round_pd(v, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+    const __m256d key = _mm256_add_pd(down, _mm256_and_pd(_mm256_cmp_pd(down, v, _CMP_LT_OQ), upLane));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(&keys[k].min[0]), _mm256_cvttpd_epi32(key));
+    __m128d w = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(&b.max[1]))));
+    w = _mm_min_pd(_mm_max_pd(_mm_mul_pd(_mm_sub_pd(w, origin2), scale2), _mm_setzero_pd()), top2);
+    const __m128d down2 = _mm_cvtepi32_pd(_mm_cvttpd_epi32(w));
+    const __m128d key2 = _mm_add_pd(down2, _mm_and_pd(_mm_cmplt_pd(down2, w), one2));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(&keys[k].max[1]), _mm_cvttpd_epi32(key2));
+  }
+}
+#endif
+
+}  // namespace
+
+void quantizeAll(const KeyGrid& grid, std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
+                 std::span<KeyBox> keys) {
+#if defined(__x86_64__)
+  const double int32Keys = 0x7fffffff;
+  if (cpuHasAvx2() && grid.top[0] <= int32Keys && grid.top[1] <= int32Keys && grid.top[2] <= int32Keys) {
+    quantizeAvx2(grid, boxes, ids, keys);
+    return;
+  }
+#endif
+  for (std::size_t k = 0; k < ids.size(); ++k) keys[k] = quantize(grid, boxes[ids[k]]);
 }
 
 bool fitsCells(const KeyGrid& grid, const KeyBox& key) {

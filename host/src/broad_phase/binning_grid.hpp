@@ -3,6 +3,7 @@
 // on a grid the host picks, rounding outwards so no overlap is lost.
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -23,11 +24,21 @@ struct KeyGrid {
   std::array<unsigned, 3> dims{1, 1, 1};
 };
 
-/// The grid for `ids` (boxes of `boxes`): s = the device's largest shift (the
+/// Per axis the least min and the greatest max of the boxes added (for none, lo above hi).
+struct AxisBounds {
+  std::array<double, 3> lo{HUGE_VAL, HUGE_VAL, HUGE_VAL};
+  std::array<double, 3> hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  void add(const Aabb& b);
+};
+
+/// The grid for boxes within `bounds`: s = the device's largest shift (the
 /// finest keys), and per axis the cell edge max(range / 2^cellBits,
 /// `cellEdge`), so a box no longer than that edge spans at most two cells.
+KeyGrid gridFor(const BinningParams& p, const AxisBounds& bounds, const std::array<double, 3>& cellEdge);
+
+/// gridFor the bounds of `ids` (boxes of `boxes`).
 KeyGrid pickGrid(const BinningParams& p, std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
-                   const std::array<double, 3>& cellEdge);
+                 const std::array<double, 3>& cellEdge);
 
 /// Box b's keys on `grid`: min rounded down, max up, clamped to the grid.
 /// Each step (float to double, subtract, multiply by the positive scale,
@@ -35,13 +46,24 @@ KeyGrid pickGrid(const BinningParams& p, std::span<const Aabb> boxes, std::span<
 /// keep overlapping, and the device reports a superset of the pairs.
 KeyBox quantize(const KeyGrid& grid, const Aabb& b);
 
+/// keys[k] = quantize(grid, boxes[ids[k]]) for every k, bit for bit, with
+/// vector instructions where the CPU has them (keys is ids.size() long).
+void quantizeAll(const KeyGrid& grid, std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
+                 std::span<KeyBox> keys);
+
 /// Whether `key` covers at most two cells per axis (what the device takes).
 bool fitsCells(const KeyGrid& grid, const KeyBox& key);
 
-/// Per axis, the cell edge the grid must reach, with a margin for the keys'
-/// rounding: the longest finite extent, unless it is above twice the extent
-/// all but n / 256 boxes stay within (outliers); then twice that extent, and
-/// the longer boxes (at most n / 256 an axis) take the host's exact path.
-std::array<double, 3> cellEdgeFor(const BinningParams& p, std::span<const Aabb> boxes);
+/// What the host reads of a frame's boxes before it picks a grid, in one pass.
+struct ExtentSurvey {
+  /// Per axis, the cell edge the grid must reach, with a margin for the keys'
+  /// rounding: the longest finite extent, unless it is above twice the extent
+  /// all but n / 256 boxes stay within (outliers); then twice that extent, and
+  /// the longer boxes (at most n / 256 an axis) take the host's exact path.
+  std::array<double, 3> cellEdge{};
+  AxisBounds bounds;       // of every box
+  bool allWithin = false;  // no outlier and no infinite extent: every box is within the cell edge
+};
+ExtentSurvey surveyExtents(const BinningParams& p, std::span<const Aabb> boxes);
 
 }  // namespace bpaccel

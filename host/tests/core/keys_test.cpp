@@ -114,6 +114,19 @@ TEST(ToKeys, RejectsEveryBadFieldAtEveryPositionOfAGroupOfBoxes) {
       }
     }
   }
+  // Many boxes: checkBoxes scans blocks of them branch-free and reads a flagged block again; every block
+  // edge, the last partial block, and the first of two bad boxes.
+  for (std::size_t at : {0u, 1u, 255u, 256u, 257u, 511u, 512u, 700u, 766u}) {
+    std::vector<Aabb> boxes(767, Aabb{{-1, -2, -3}, {1, 2, 3}});
+    boxes[at].max[2] = std::nanf("");
+    if (at + 300 < boxes.size()) boxes[at + 300].min[0] = 5;
+    try {
+      checkBoxes(boxes);
+      ADD_FAILURE() << "checkBoxes accepted a NaN at " << at;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.object(), at);
+    }
+  }
   // Touching and zero-extent boxes, and -0.0 against +0.0, are fine.
   std::vector<Aabb> good(5, Aabb{{-0.0f, 0, 1}, {0.0f, 0, 1}});
   std::vector<KeyBox> keys;
