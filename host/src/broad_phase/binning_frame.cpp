@@ -23,7 +23,8 @@ void BinningFrame::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out
 }
 
 void BinningFrame::plan(std::span<const Aabb> boxes) {
-  checkBoxes(boxes);
+  const BinningParams& p = device_.params();
+  const ExtentSurvey survey = surveyExtents(p, boxes);  // checks the boxes
   boxes_ = boxes;
   stats_ = {};
   for (PlannedFrame& f : frames_) spare_.push_back(std::move(f));  // their buffers, for this frame's
@@ -32,8 +33,6 @@ void BinningFrame::plan(std::span<const Aabb> boxes) {
   hostPairs_.clear();
   longIds_.clear();
   isLong_.assign(boxes.size(), 0);
-  const BinningParams& p = device_.params();
-  const ExtentSurvey survey = surveyExtents(p, boxes);
   cellEdge_ = survey.cellEdge;
   PlannedFrame whole = takeSpare();
   AxisBounds bounds = survey.bounds;
@@ -126,10 +125,7 @@ PlannedFrame BinningFrame::makeFrame(std::vector<std::uint32_t> ids, int axis, d
 void BinningFrame::fillKeys(PlannedFrame& f, int axis, double lo, double hi) {
   f.axis = axis, f.lo = lo, f.hi = hi;
   f.keys.resize(f.ids.size());
-  quantizeAll(f.grid, boxes_, f.ids, f.keys);
-  bool allFit = true;
-  for (const KeyBox& k : f.keys) allFit &= fitsCells(f.grid, k);
-  if (allFit) [[likely]]
+  if (quantizeAll(f.grid, boxes_, f.ids, f.keys)) [[likely]]
     return;
   // By construction no box spans more than two cells; should rounding ever say otherwise, the box is the host's.
   std::size_t n = 0;

@@ -10,6 +10,7 @@
 #endif
 
 #include "../core/cpu_features.hpp"
+#include "../core/keys.hpp"
 
 namespace bpaccel {
 
@@ -28,6 +29,7 @@ struct ExtentBrief {
   std::array<double, 3> longest{};
   AxisBounds bounds;
   std::array<std::size_t, 3> notFinite{}, top{};
+  bool checked = false;  // the vector pass saw every extent >= 0 (no NaN, no min above max)
 };
 
 /// The lowest extent of the top buckets: 2^(x - 1) for the longest's binary exponent x; 0 if there is none.
@@ -54,7 +56,7 @@ void briefScalar(std::span<const Aabb> boxes, std::size_t from, ExtentBrief& bri
 __attribute__((target("avx2"))) std::size_t briefAvx2(std::span<const Aabb> boxes, ExtentBrief& brief) {
   if (boxes.size() < 2) return 0;
   const __m256d infinity = _mm256_set1_pd(HUGE_VAL), one = _mm256_set1_pd(1);
-  __m256d longest = _mm256_setzero_pd(), notFinite = _mm256_setzero_pd();
+  __m256d longest = _mm256_setzero_pd(), notFinite = _mm256_setzero_pd(), suspect = _mm256_setzero_pd();
   __m256d lo = infinity, hi = _mm256_set1_pd(-HUGE_VAL);
   const std::size_t last = boxes.size() - 1;
   for (std::size_t i = 0; i < last; ++i) {
@@ -64,8 +66,12 @@ __attribute__((target("avx2"))) std::size_t briefAvx2(std::span<const Aabb> boxe
     const __m256d finite = _mm256_cmp_pd(e, infinity, _CMP_LT_OQ);
     longest = _mm256_max_pd(longest, _mm256_and_pd(finite, e));
     notFinite = _mm256_add_pd(notFinite, _mm256_andnot_pd(finite, one));
+    // A NaN, or a min above its max (an exact difference of floats is negative then), makes !(e >= 0);
+    // so does +inf - +inf, a good box, which checkBoxes then passes.
+    suspect = _mm256_or_pd(suspect, _mm256_cmp_pd(e, _mm256_setzero_pd(), _CMP_NGE_UQ));
     lo = _mm256_min_pd(lo, mins), hi = _mm256_max_pd(hi, maxs);
   }
+  brief.checked = (_mm256_movemask_pd(suspect) & 0b111) == 0;
   alignas(32) std::array<double, 4> l, n, b0, b1;
   _mm256_store_pd(l.data(), longest), _mm256_store_pd(n.data(), notFinite);
   _mm256_store_pd(b0.data(), lo), _mm256_store_pd(b1.data(), hi);
@@ -97,12 +103,9 @@ __attribute__((target("avx2"))) std::size_t topAvx2(std::span<const Aabb> boxes,
 }
 #endif
 
-ExtentBrief briefOf(std::span<const Aabb> boxes) {
-  ExtentBrief brief;
-  std::size_t from = 0, topFrom = 0;
-#if defined(__x86_64__)
-  if (cpuHasAvx2()) from = briefAvx2(boxes, brief);
-#endif
+/// The brief of boxes from `from` on added to `brief`, then the top buckets' counts of all of them.
+void completeBrief(std::span<const Aabb> boxes, std::size_t from, ExtentBrief& brief) {
+  std::size_t topFrom = 0;
   briefScalar(boxes, from, brief);
 #if defined(__x86_64__)
   if (cpuHasAvx2()) topFrom = topAvx2(boxes, brief);
@@ -110,7 +113,6 @@ ExtentBrief briefOf(std::span<const Aabb> boxes) {
   for (std::size_t i = topFrom; i < boxes.size(); ++i)
     for (int a = 0; a < 3; ++a)
       brief.top[a] += double{boxes[i].max[a]} - double{boxes[i].min[a]} >= topFloor(brief.longest[a]);
-  return brief;
 }
 
 }  // namespace
@@ -119,9 +121,20 @@ ExtentSurvey surveyExtents(const BinningParams& p, std::span<const Aabb> boxes) 
   const std::size_t outliers = boxes.size() / 256;
   const double keys = std::ldexp(1.0, static_cast<int>(p.maxShift()));
   ExtentSurvey survey;
+  ExtentBrief brief;
+  std::size_t from = 0;
+#if defined(__x86_64__)
+  if (cpuHasAvx2()) from = briefAvx2(boxes, brief);
+#endif
+  // The exact check on the bits, naming the first bad box, unless the vector pass saw none (the box it
+  // leaves is checked alone).
+  if (brief.checked)
+    checkBoxes(boxes.subspan(from), from);
+  else
+    checkBoxes(boxes);
+  completeBrief(boxes, from, brief);
   // The common frame: every extent finite, and more than the outliers in the longest's top buckets, so the
   // (outliers + 1)-th longest is there too and no extent is an outlier: the brief's two vector passes tell.
-  const ExtentBrief brief = briefOf(boxes);
   bool common = true;
   for (int a = 0; a < 3; ++a) common = common && brief.notFinite[a] == 0 && brief.top[a] > outliers && topFloor(brief.longest[a]) > 0;
   if (common) {
@@ -208,7 +221,7 @@ namespace {
 // a max lane adds one where the floor is below the value), so the keys are the scalar loop's bit for bit:
 // min x, y, z and max x in one AVX vector, max y and z in an SSE2 one. Keys must fit an int32 (the
 // conversion is signed): the caller checks top. No lambdas: they would not inherit the target attribute.
-__attribute__((target("avx2"))) void quantizeAvx2(const KeyGrid& g, std::span<const Aabb> boxes,
+__attribute__((target("avx2"))) bool quantizeAvx2(const KeyGrid& g, std::span<const Aabb> boxes,
                                                  std::span<const std::uint32_t> ids, std::span<KeyBox> keys) {
   const __m256d origin = _mm256_setr_pd(g.origin[0], g.origin[1], g.origin[2], g.origin[0]);
   const __m256d scale = _mm256_setr_pd(g.scale[0], g.scale[1], g.scale[2], g.scale[0]);
@@ -216,34 +229,46 @@ __attribute__((target("avx2"))) void quantizeAvx2(const KeyGrid& g, std::span<co
   const __m256d upLane = _mm256_setr_pd(0, 0, 0, 1);  // lane 3 is a max: rounded up
   const __m128d origin2 = _mm_setr_pd(g.origin[1], g.origin[2]), scale2 = _mm_setr_pd(g.scale[1], g.scale[2]);
   const __m128d top2 = _mm_setr_pd(g.top[1], g.top[2]), one2 = _mm_set1_pd(1);
+  const __m128i shift = _mm_cvtsi32_si128(static_cast<int>(g.shift)), one = _mm_set1_epi32(1);
+  const __m128i axes = _mm_setr_epi32(-1, -1, -1, 0);
+  __m128i wide = _mm_setzero_si128();  // lanes where a box spans more than two cells
   for (std::size_t k = 0; k < ids.size(); ++k) {
     const Aabb& b = boxes[ids[k]];
     __m256d v = _mm256_cvtps_pd(_mm_loadu_ps(&b.min[0]));
     v = _mm256_min_pd(_mm256_max_pd(_mm256_mul_pd(_mm256_sub_pd(v, origin), scale), _mm256_setzero_pd()), top);
     const __m256d down = _mm256_round_pd(v, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
     const __m256d key = _mm256_add_pd(down, _mm256_and_pd(_mm256_cmp_pd(down, v, _CMP_LT_OQ), upLane));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(&keys[k].min[0]), _mm256_cvttpd_epi32(key));
+    const __m128i low = _mm256_cvttpd_epi32(key);  // min x, y, z, max x
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(&keys[k].min[0]), low);
     __m128d w = _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(&b.max[1]))));
     w = _mm_min_pd(_mm_max_pd(_mm_mul_pd(_mm_sub_pd(w, origin2), scale2), _mm_setzero_pd()), top2);
     const __m128d down2 = _mm_cvtepi32_pd(_mm_cvttpd_epi32(w));
     const __m128d key2 = _mm_add_pd(down2, _mm_and_pd(_mm_cmplt_pd(down2, w), one2));
-    _mm_storel_epi64(reinterpret_cast<__m128i*>(&keys[k].max[1]), _mm_cvttpd_epi32(key2));
+    const __m128i high = _mm_cvttpd_epi32(key2);  // max y, z, then zeros
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(&keys[k].max[1]), high);
+    // fitsCells: (max >> s) - (min >> s) <= 1 on each axis, the maxes being words 3 .. 5 of the six.
+    const __m128i cells = _mm_sub_epi32(_mm_srl_epi32(_mm_alignr_epi8(high, low, 12), shift), _mm_srl_epi32(low, shift));
+    wide = _mm_or_si128(wide, _mm_and_si128(_mm_cmpgt_epi32(cells, one), axes));
   }
+  return _mm_movemask_epi8(wide) == 0;
 }
 #endif
 
 }  // namespace
 
-void quantizeAll(const KeyGrid& grid, std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
+bool quantizeAll(const KeyGrid& grid, std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
                  std::span<KeyBox> keys) {
 #if defined(__x86_64__)
   const double int32Keys = 0x7fffffff;
-  if (cpuHasAvx2() && grid.top[0] <= int32Keys && grid.top[1] <= int32Keys && grid.top[2] <= int32Keys) {
-    quantizeAvx2(grid, boxes, ids, keys);
-    return;
-  }
+  if (cpuHasAvx2() && grid.top[0] <= int32Keys && grid.top[1] <= int32Keys && grid.top[2] <= int32Keys)
+    return quantizeAvx2(grid, boxes, ids, keys);
 #endif
-  for (std::size_t k = 0; k < ids.size(); ++k) keys[k] = quantize(grid, boxes[ids[k]]);
+  bool allFit = true;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    keys[k] = quantize(grid, boxes[ids[k]]);
+    allFit &= fitsCells(grid, keys[k]);
+  }
+  return allFit;
 }
 
 bool fitsCells(const KeyGrid& grid, const KeyBox& key) {

@@ -48,7 +48,8 @@ KeyBox quantize(const KeyGrid& grid, const Aabb& b);
 
 /// keys[k] = quantize(grid, boxes[ids[k]]) for every k, bit for bit, with
 /// vector instructions where the CPU has them (keys is ids.size() long).
-void quantizeAll(const KeyGrid& grid, std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
+/// Returns whether every box's keys fit the cells (fitsCells).
+bool quantizeAll(const KeyGrid& grid, std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
                  std::span<KeyBox> keys);
 
 /// Whether `key` covers at most two cells per axis (what the device takes).
@@ -64,6 +65,8 @@ struct ExtentSurvey {
   AxisBounds bounds;       // of every box
   bool allWithin = false;  // no outlier and no infinite extent: every box is within the cell edge
 };
+/// The survey of `boxes`, which it checks as checkBoxes does (in its first
+/// pass where it can): throws InputError for the first bad box.
 ExtentSurvey surveyExtents(const BinningParams& p, std::span<const Aabb> boxes);
 
 }  // namespace bpaccel

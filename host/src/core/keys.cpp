@@ -289,15 +289,15 @@ void convert(std::span<const Aabb> boxes, std::vector<KeyBox>& out, KeyBounds* b
 
 }  // namespace
 
-void checkBoxes(std::span<const Aabb> boxes) {
-  checkObjectCount(boxes.size());
+void checkBoxes(std::span<const Aabb> boxes, std::size_t firstIndex) {
+  checkObjectCount(firstIndex + boxes.size());
   // The vector converter's check, a block at a time into keys that stay in the L1 cache and are dropped;
   // a flagged block is read again box by box to name the first bad one.
   std::array<KeyBox, 256> scratch;
   for (std::size_t begin = 0; begin < boxes.size(); begin += scratch.size()) {
     const auto block = boxes.subspan(begin, std::min(scratch.size(), boxes.size() - begin));
     if (convertPart(block, std::span<KeyBox>(scratch).first(block.size()), nullptr)) [[unlikely]]
-      for (std::size_t i = 0; i < block.size(); ++i) checkBox(begin + i, block[i]);
+      for (std::size_t i = 0; i < block.size(); ++i) checkBox(firstIndex + begin + i, block[i]);
   }
 }
 

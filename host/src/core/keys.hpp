@@ -34,8 +34,9 @@ constexpr std::uint64_t kMaxObjects = 0xFFFFFFFFull;
 /// Checks every box: no NaN, min <= max on every axis (in key order, so -0.0
 /// equals +0.0, and on the bits, so -ffast-math cannot fold it away), count
 /// within kMaxObjects. Throws InputError for the first bad box, naming it, its
-/// axis and its values.
-void checkBoxes(std::span<const Aabb> boxes);
+/// axis and its values; boxes[i] is named object firstIndex + i (the boxes
+/// are then the part of a scene from there on).
+void checkBoxes(std::span<const Aabb> boxes, std::size_t firstIndex = 0);
 
 /// Checks every box as checkBoxes does and converts it to keys. Throws
 /// InputError for the first bad box; `out` is reused across calls to avoid

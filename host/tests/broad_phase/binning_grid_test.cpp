@@ -41,6 +41,7 @@ TEST(QuantizeAll, GivesQuantizesKeysBitForBitForEveryCountOrderAndGridEdge) {
           std::uniform_real_distribution<double> at(-0.2 * span, 1.2 * span);
           double lo = at(rng), hi = lo + std::abs(at(rng)) * 0.01;
           if (i % 3 == 0) lo = std::floor(lo / g.unit[a]) * g.unit[a], hi = std::ceil(hi / g.unit[a]) * g.unit[a];
+          if (i % 50 == 7 && a == static_cast<int>(i % 3)) hi = lo + 0.5 * span;  // across several cells
           boxes[i].min[a] = static_cast<float>(g.origin[a] + lo);
           boxes[i].max[a] = std::max(boxes[i].min[a], static_cast<float>(g.origin[a] + hi));
         }
@@ -48,14 +49,17 @@ TEST(QuantizeAll, GivesQuantizesKeysBitForBitForEveryCountOrderAndGridEdge) {
       std::iota(ids.begin(), ids.end(), 0u);
       std::shuffle(ids.begin(), ids.end(), rng);
       std::vector<KeyBox> keys(n);
-      quantizeAll(g, boxes, ids, keys);
+      const bool allFit = quantizeAll(g, boxes, ids, keys);
+      bool wantAllFit = true;
       for (std::size_t k = 0; k < n; ++k) {
         const KeyBox want = quantize(g, boxes[ids[k]]);
+        wantAllFit = wantAllFit && fitsCells(g, want);
         for (int a = 0; a < 3; ++a) {
           ASSERT_EQ(keys[k].min[a], want.min[a]) << "width " << keyWidth << " n " << n << " k " << k << " axis " << a;
           ASSERT_EQ(keys[k].max[a], want.max[a]) << "width " << keyWidth << " n " << n << " k " << k << " axis " << a;
         }
       }
+      EXPECT_EQ(allFit, wantAllFit) << "width " << keyWidth << " n " << n;
     }
   }
 }
