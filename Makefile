@@ -203,9 +203,23 @@ fuzz-long: fuzz
 # FPGA flow (docs/fpga.md): ECP5 synthesis, place and route on FPGA_PART with
 # a measured Fmax, and a Xilinx 7-series synthesis estimate. The Verilog does
 # not depend on the part: its folder is named by the design alone.
+# ARCH=binning: the binning device (docs/binning.md) as EmitBinning builds it,
+# its defaults or BINNING_ARGS (EmitBinning's own options, e.g.
+# BINNING_ARGS="--lanes-per-group 4"); M, CAPACITY and KEY_WIDTH do not apply.
+# Its folder and report are named from the parameter file it writes.
+BINNING_ARGS ?=
+BINNING_STAGING := build/fpga-verilog/binning-emitting
 fpga: deps
+ifeq ($(ARCH),binning)
+	rm -rf $(BINNING_STAGING)
+	$(SBT) "runMain bpaccel.binning.EmitBinning $(BINNING_ARGS) --target-dir $(BINNING_STAGING)"
+	name=$$($(PYTHON) scripts/fpga/names.py --params $(BINNING_STAGING)/bpaccel_params.json) && \
+	  rm -rf build/fpga-verilog/$$name && mv $(BINNING_STAGING) build/fpga-verilog/$$name && \
+	  $(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/$$name $(if $(FPGA_PART),--part $(FPGA_PART)) $(FPGA_ARGS)
+else
 	$(MAKE) verilog ARCH=$(ARCH) M=$(M) CAPACITY=$(CAPACITY) KEY_WIDTH=$(KEY_WIDTH) MEMORY_STYLE=$(FPGA_MEMORY_STYLE) VERILOG_DIR=build/fpga-verilog/$(FPGA_DESIGN)
 	$(PYTHON) scripts/fpga/flow.py --verilog-dir build/fpga-verilog/$(FPGA_DESIGN) --out results/fpga/$(FPGA_NAME).json $(if $(FPGA_PART),--part $(FPGA_PART)) $(FPGA_ARGS)
+endif
 
 fpga-sweep: deps
 	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --key-width $(KEY_WIDTH) $(if $(CAPACITY),--capacity $(CAPACITY)) $(if $(FPGA_MEMORY_STYLE),--memory-style $(FPGA_MEMORY_STYLE)) --verilog-root build/fpga-verilog --emit always --budget-min 60

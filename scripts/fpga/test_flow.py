@@ -12,7 +12,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))  # the flow's package, for the tests that need no tools
-from fpgaflow import ecp5, names, tools  # noqa: E402
+from fpgaflow import design, ecp5, names, tools  # noqa: E402
 
 VERILOG_DIRS: dict[str, Path] = {}
 FLOWS: dict[str, tuple[subprocess.Popen, Path, Path, Path]] = {}  # arch: (its run, report, work dir, output)
@@ -146,6 +146,50 @@ class PartsToPlaceOn(unittest.TestCase):
                                  capture_output=True, text=True)
             self.assertEqual(run.returncode, 2)
             self.assertIn("--part", run.stderr)
+
+
+class BinningDeviceParameters(unittest.TestCase):
+    """The binning device's parameter file (EmitBinning's words: lanes, box_capacity) read in the
+    flow's words, its names, and its group memories' check."""
+    PARAMS = {"arch": "binning", "groups": 32, "lanes_per_group": 2, "lanes": 64, "key_width": 12,
+              "box_capacity": 8192, "memory_style": "inferred", "top": "BinningCore",
+              "memory_module": "mem_1024x71", "memory_count": 64, "dp16kd_estimate": 160}
+
+    def read(self, **changes) -> dict:
+        with tempfile.TemporaryDirectory() as d:
+            (Path(d) / design.PARAMS_FILE).write_text(json.dumps(dict(self.PARAMS, **changes)))
+            return design.read_params(Path(d))
+
+    def test_reads_lanes_as_m_and_the_box_capacity_as_capacity(self):
+        p = self.read()
+        self.assertEqual((p["m"], p["capacity"], p["top"]), (64, 8192, "BinningCore"))
+        with self.assertRaises(tools.FlowError):  # --m checks the lanes
+            with tempfile.TemporaryDirectory() as d:
+                (Path(d) / design.PARAMS_FILE).write_text(json.dumps(self.PARAMS))
+                design.read_params(Path(d), m=32)
+        stream = {"arch": "stream", "m": 8, "capacity": 512}
+        self.assertIs(names.flow_params(stream), stream)
+
+    def test_names_it_by_lanes_and_only_what_differs_from_its_defaults(self):
+        self.assertEqual(names.params_name(self.read()), "binning-m64")
+        self.assertEqual(names.params_name(self.read(), "lfe5um5g-85f"), "binning-m64-lfe5um5g-85f")
+        self.assertEqual(names.params_name(self.read(lanes=128, box_capacity=4096, key_width=16)),
+                         "binning-m128-c4096-k16")
+        self.assertEqual(names.design_name("binning", 64), "binning-m64")
+        # Its default key width is its own: the other architectures' names are unchanged.
+        self.assertEqual(names.design_name("stream", 64, 12), "stream-m64-k12")
+        self.assertEqual(names.design_name("stream", 64), "stream-m64")
+
+    def test_counts_the_group_memories_in_block_ram(self):
+        core = type("Core", (), {"params": dict(self.PARAMS), "memory_module": "mem_1024x71"})()
+        log = "".join(f"mapping memory FpgaTop.core.g{i}.mem_ext.Memory via $__ECP5_PDPW16KD_\n" for i in range(64))
+        tables = "".join(f"mapping memory FpgaTop.core.t{i}.mem_ext.Memory via $__TRELLIS_DPR16X4_\n" for i in range(32))
+        cells = {"DP16KD": 160, "TRELLIS_DPR16X4": 768}
+        ok = ecp5.memories(core, cells, log + tables, [])
+        self.assertTrue(ok["memories_in_bram"], ok)
+        self.assertEqual((ok["dp16kd"], ok["dp16kd_estimate"], ok["lut_ram_trellis_dpr16x4"]), (160, 160, 768))
+        one_in_lut_ram = log.replace("PDPW16KD", "TRELLIS_DPR16X4", 1)
+        self.assertFalse(ecp5.memories(core, cells, one_in_lut_ram + tables, [])["memories_in_bram"])
 
 
 class FlowRefusesBadInput(unittest.TestCase):

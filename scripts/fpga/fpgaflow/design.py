@@ -14,6 +14,7 @@ import shutil
 from collections import Counter
 from pathlib import Path
 
+from .names import flow_params
 from .tools import EXIT_INPUT, EXIT_TOOL, FlowError, Runner
 
 WRAPPER_TOP = "FpgaTop"
@@ -25,7 +26,7 @@ def read_params(vdir: Path, m: int | None = None) -> dict:
     path = vdir / PARAMS_FILE
     if not path.is_file():
         raise FlowError(EXIT_INPUT, f"{path} not found (emit the design with: make verilog VERILOG_DIR={vdir})")
-    params = json.loads(path.read_text())
+    params = flow_params(json.loads(path.read_text()))
     if m is not None and params["m"] != m:
         raise FlowError(EXIT_INPUT, f"--m {m} but {path} says m = {params['m']}")
     return params

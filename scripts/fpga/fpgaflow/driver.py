@@ -1,4 +1,5 @@
-"""FPGA synthesis / place-and-route flow for one emitted configuration of BroadPhaseAccel.
+"""FPGA synthesis / place-and-route flow for one emitted configuration of BroadPhaseAccel
+or of the binning device (BinningCore).
 
 ECP5 (measured): Yosys `synth_ecp5` then `nextpnr-ecp5` place and route on
 --part (LFE5U-85F speed 6 by default, or LFE5UM5G-85F speed 8); resources and the maximum clock frequency come from nextpnr's own

@@ -92,6 +92,9 @@ def source_files(design: Design) -> tuple[list[str], list[dict]]:
     style ecp5-outreg) replaced by its DP16KD build; and those memories' facts."""
     if not design.registered_memories:
         return list(design.files), []
+    if design.params["arch"] == "binning":
+        raise FlowError(EXIT_INPUT, "memory style ecp5-outreg of the binning device (two memory modules per group) "
+                                    "is not built by the flow: emit it with the inferred style")
     name = design.memory_module
     source, facts = registered_memory(name, design.params["memory_rows"], design.params["memory_width"],
                                       design.modules[name].port_widths())
@@ -152,6 +155,8 @@ def memories(design: Design, cells: dict[str, int], text: str, registered: list[
     """Whether every coordinate memory became block RAM (seed: 6m striped memories; stream:
     one of six keys a row), from the synthesis log; the result queue's small memory may
     go to LUT RAM."""
+    if design.params["arch"] == "binning":
+        return group_memories(design, cells, text)
     n_mems = design.params["memory_count"]
     mapping = memory_mapping(text, COORD_MEMORY_RE)
     dp16 = cells.get("DP16KD", 0)
@@ -164,18 +169,43 @@ def memories(design: Design, cells: dict[str, int], text: str, registered: list[
         in_bram = bram_mapped == n_mems and dp16 >= n_mems and "FF" not in mapping \
             and not any("DPR16X4" in k for k in mapping)
     per_mem = dp16 / n_mems if n_mems else None
-    if not in_bram:
-        log("WARNING: memories did NOT all map to DP16KD block RAM: " + json.dumps(mapping))
     return {
-        "instances": n_mems,
-        "module": [design.memory_module],
-        "style": design.params["memory_style"],
+        **mapped_memories(design, in_bram, mapping, "memories"),
         "ecp5_mapping": mapping,
         "ecp5_mapping_all_memories": memory_mapping(text),
         "dp16kd_per_memory": per_mem,
         "memories_in_bram": in_bram,
         "note": memory_note(design, in_bram, per_mem, dp16, registered),
     }
+
+
+def group_memories(design: Design, cells: dict[str, int], text: str) -> dict:
+    """The binning device: whether its group memories (an entry and an order memory per group,
+    `memory_count` in all) all became block RAM, from the synthesis log. Its cell tables go to
+    LUT RAM by design; the queues' small memories may go to LUT RAM or flip-flops."""
+    n_mems, estimate = design.params["memory_count"], design.params["dp16kd_estimate"]
+    mapping = memory_mapping(text)
+    dp16 = cells.get("DP16KD", 0)
+    in_bram = sum(v for k, v in mapping.items() if "16KD" in k) == n_mems
+    return {
+        **mapped_memories(design, in_bram, mapping, "the group memories"),
+        "ecp5_mapping_all_memories": mapping,
+        "dp16kd": dp16,
+        "dp16kd_estimate": estimate,
+        "lut_ram_trellis_dpr16x4": cells.get("TRELLIS_DPR16X4", 0),
+        "memories_in_bram": in_bram,
+        "note": (f"{n_mems} group memories (entry and order memory of each group) mapped to block RAM: {dp16} "
+                 f"DP16KD (BinningParams.dp16kdEstimate: {estimate}); the cell tables in LUT RAM"
+                 if in_bram else "the group memories are not all in DP16KD block RAM: see ecp5_mapping_all_memories"),
+    }
+
+
+def mapped_memories(design: Design, in_bram: bool, mapping: dict, what: str) -> dict:
+    """The facts every memory report starts with; a warning when `what` are not all in block RAM."""
+    if not in_bram:
+        log(f"WARNING: {what} did NOT all map to DP16KD block RAM: " + json.dumps(mapping))
+    return {"instances": design.params["memory_count"], "module": [design.memory_module],
+            "style": design.params["memory_style"]}
 
 
 def memory_note(design: Design, in_bram: bool, per_mem, dp16: int, registered: list[dict]) -> str:

@@ -125,7 +125,7 @@ def write_json(path: Path, data: dict) -> None:
 
 
 def print_summary(r: dict) -> None:
-    print(f"== BroadPhaseAccel m={r['m']} capacity={r['capacity']} on {r['part']['ecp5']}")
+    print(f"== {r['arch']} m={r['m']} capacity={r['capacity']} on {r['part']['ecp5']}")
     if r["status"] == "does_not_fit":
         over = r["ecp5_demand"]["over_capacity"]
         print("   ECP5: DOES NOT FIT: " + (", ".join(f"{k} {v['used']}/{v['available']}" for k, v in over.items())

@@ -40,6 +40,12 @@ object BinningHeader {
       num("COUNTER_WIDTH", p.counterWidth),
       num("DEBUG_PORT", if (p.debugPort) 1 else 0),
       "MEMORY_STYLE" -> Right(p.memoryStyle.name),
+      // For the FPGA flow (scripts/fpga): the top module, the entry memory's module, the group
+      // memories meant for block RAM (entry and order memory of each group) and their DP16KD estimate.
+      "TOP" -> Right(classOf[BinningCore].getSimpleName),
+      "MEMORY_MODULE" -> Right(p.memoryStyle.moduleName(p.groupCapacity, p.entryBits)),
+      num("MEMORY_COUNT", 2 * p.groups),
+      num("DP16KD_ESTIMATE", p.dp16kdEstimate()),
       "FINGERPRINT" -> Right(p.fingerprint)
     ) ++ BinningErrorCode.names.map { case (name, code) => num(s"ERROR_$name", code) }
   }

@@ -83,6 +83,12 @@ class BinningEmissionSpec extends AnyFlatSpec with Matchers {
     header should include(s"#define BPACCEL_BIN_FINGERPRINT \"${p.fingerprint}\"\n")
     json should include(s"\"lanes_per_group\": ${p.g},")
     json should include(s"\"box_capacity\": ${p.boxCapacity},")
+    // What the FPGA flow reads: modules that exist in the emitted files.
+    json should include("\"top\": \"BinningCore\",")
+    json should include(s"\"memory_module\": \"mem_${p.groupCapacity}x${p.entryBits}\",")
+    Files.exists(dir.resolve("BinningCore.sv")) shouldBe true
+    Files.exists(dir.resolve(s"mem_${p.groupCapacity}x${p.entryBits}.sv")) shouldBe true
+    json should include(s"\"memory_count\": ${2 * p.groups},")
     for ((name, code) <- BinningErrorCode.names) {
       header should include(s"#define BPACCEL_BIN_ERROR_$name $code\n")
       json should include(s"\"error_${name.toLowerCase}\": $code")
