@@ -727,7 +727,8 @@ std::string Benchmark::table(const nlohmann::json& results) {
         "accelerator = measured host + modelled device (device cycles with loads, {} backend{}) + modelled transfer "
         "({}; boxes stream through the {:g}-byte-a-cycle load port, so only the link's excess over one cycle a box "
         "counts; 'accelerator binning': the binning device's C++ cycle model, each box sent once, the link's excess over "
-        "its intake, the profile's clock standing in, as no place-and-route report of the binning design exists)",
+        "its intake, at the binning design's own clock where its report on the profile's part is valid, else the "
+        "stream device's standing in (the profile says which))",
         cfg["accelerator_backend"].get<std::string>(), keys, platforms, cfg["link_model"].value("bytes_per_box", 24.0));
   }
   header("Median broad-phase time per frame, ms, one thread unless named (" + legend +

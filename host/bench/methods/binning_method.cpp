@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
+
+#include "model/fpga_report.hpp"
 
 namespace bpaccel {
 
@@ -65,18 +68,43 @@ FrameTime BinningMethod::frameTime(double measuredSeconds) const {
   return {p.hostSeconds + p.deviceSeconds + p.transferSeconds, p};
 }
 
+DeviceProfile binningProfile(const DeviceProfile& profile, const BinningParams& params, const std::string& fpgaDir) {
+  ProfileInputs in;
+  in.device = {static_cast<int>(params.lanes()), "binning", static_cast<int>(params.keyWidth)};
+  in.fpgaDir = fpgaDir;
+  in.lfe5uReport = (std::filesystem::path(fpgaDir) /
+                    std::filesystem::path(fpgaReportPath(in.device.m, in.device.arch, in.device.keyWidth)).filename())
+                       .string();
+  ProfiledValue standIn = profile.part.clockHz;  // measured or not, it is another design's
+  if (standIn.provenance == Provenance::Measured) standIn.provenance = Provenance::StandIn;
+  standIn.source = "stand-in: the stream device's clock, " + standIn.source;
+  DeviceProfile p = profile;
+  if (profile.name == "ecp5-5g") {
+    std::string report = findFiveGReport(in);
+    if (report.empty()) report = in.lfe5uReport + " with -lfe5um5g-85f (none found)";
+    p.part = resolvePart(profile.part.name, profile.part.speedGrade, std::move(report), in.device, standIn);
+    return p;
+  }
+  const DeviceClock c = clockFromFpgaReport(in.lfe5uReport, in.device.m, in.device.arch, in.device.keyWidth);
+  if (c.measured) {
+    p.part.clockHz = {c.hz, Provenance::StandIn, "stand-in: the binning design's LFE5U-85F speed 6 clock, " + c.source};
+  } else {
+    p.part.clockHz = standIn;
+    p.part.clockHz.source = "no binning design clock (" + c.source + "); " + standIn.source;
+  }
+  return p;
+}
+
 std::vector<MethodSpec> binningMethods(const BinningParams& params, const std::vector<DeviceProfile>& profiles) {
   std::vector<MethodSpec> specs;
-  for (const DeviceProfile& profile : profiles) {
+  for (const DeviceProfile& stream : profiles) {
+    const DeviceProfile profile = binningProfile(stream, params);
     MethodSpec s;
     s.name = "accelerator binning on " + profile.name;
     s.kind = MethodKind::Accelerator;
     s.library = "bpaccel";
     s.partition = "binning";
     s.profile = profile.toJson();
-    s.profile["binning_clock_note"] =
-        "no place-and-route report of the binning design yet: the profile's clock (" + profile.part.clockHz.source +
-        ") stands in, modelled";
     s.make = [params, profile](const SceneStart&) { return std::make_unique<BinningMethod>(params, profile); };
     specs.push_back(std::move(s));
   }

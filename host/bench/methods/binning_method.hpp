@@ -71,7 +71,15 @@ class BinningMethod final : public TimedMethod {
   std::vector<Pair> pairs_;
 };
 
-/// One method per profile, named "accelerator binning on <profile>".
+/// `profile`'s platform for the binning device: the same link, and the clock
+/// of the binning design itself on the profile's part where its report there
+/// is valid (ecp5-5g: its LFE5UM5G-85F report; gen3x8: its LFE5U-85F report as
+/// a stand-in, as for the stream device). Otherwise the profile's own clock
+/// (the stream device's) stands in, its source saying why.
+DeviceProfile binningProfile(const DeviceProfile& profile, const BinningParams& params,
+                             const std::string& fpgaDir = "results/fpga");
+
+/// One method per profile, named "accelerator binning on <profile>", on binningProfile(profile).
 std::vector<MethodSpec> binningMethods(const BinningParams& params, const std::vector<DeviceProfile>& profiles);
 
 }  // namespace bpaccel

@@ -106,7 +106,7 @@ PartProfile resolvePart(std::string name, int speedGrade, std::string report, co
   p.speedGrade = speedGrade;
   p.report = std::move(report);
   p.reportPresent = !p.report.empty() && std::filesystem::is_regular_file(p.report);
-  std::string why = fmt::format("no {} report", p.name);
+  std::string why = p.report.empty() ? fmt::format("no {} report", p.name) : fmt::format("no {} report: {}", p.name, p.report);
   if (p.reportPresent) {
     const DeviceClock c = clockFromFpgaReport(p.report, device.m, device.arch, device.keyWidth);
     if (c.measured) {

@@ -5,11 +5,17 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "device/binning/binning_params.hpp"
+
 namespace bpaccel {
+
+int defaultKeyWidth(const std::string& arch) {
+  return arch == "binning" ? static_cast<int>(BinningParams{}.keyWidth) : 32;
+}
 
 std::string fpgaReportPath(int m, const std::string& arch, int keyWidth) {
   return fmt::format("results/fpga/{}m{}{}.json", arch == "seed" ? "" : arch + "-", m,
-                     keyWidth == 32 ? "" : fmt::format("-k{}", keyWidth));
+                     keyWidth == defaultKeyWidth(arch) ? "" : fmt::format("-k{}", keyWidth));
 }
 
 DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std::string& arch, int keyWidth) {

@@ -21,8 +21,12 @@ struct DeviceClock {
 /// without "key_width" are of 32-bit keys.
 DeviceClock clockFromFpgaReport(const std::string& fpgaReport, int m, const std::string& arch, int keyWidth = 32);
 
+/// The key width an architecture's report names leave out: 32, the binning
+/// device's default (BinningParams) for it (scripts/fpga/fpgaflow/names.py).
+int defaultKeyWidth(const std::string& arch);
+
 /// Where the FPGA flow writes the report of that device (make fpga's FPGA_NAME):
-/// results/fpga/[<arch>-]m<m>[-k<width>].json, no prefix for the seed, no suffix for 32-bit keys.
+/// results/fpga/[<arch>-]m<m>[-k<width>].json, no prefix for the seed, no suffix for the default key width.
 std::string fpgaReportPath(int m, const std::string& arch, int keyWidth);
 
 }  // namespace bpaccel

@@ -43,12 +43,13 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   const bpaccel::BinningParams params = bpaccel::builtBinningParams();
-  // No place-and-route report of the binning design yet: the stream device of as many lanes stands in for the clock.
+  // Each profile's clock: the binning design's own on that part where its report is valid, else the stream
+  // device's of as many lanes (binningProfile).
   const int lanes = static_cast<int>(params.lanes());
   const bpaccel::ProfileInputs in{.device = {lanes, "stream", 32},
                                   .lfe5uReport = bpaccel::fpgaReportPath(lanes, "stream", 32)};
   std::vector<bpaccel::DeviceProfile> profiles;
-  for (const auto& n : names) profiles.push_back(bpaccel::builtInProfile(n, in));
+  for (const auto& n : names) profiles.push_back(bpaccel::binningProfile(bpaccel::builtInProfile(n, in), params));
   std::vector<std::unique_ptr<bpaccel::BinningMethod>> methods;
   for (const auto& p : profiles) methods.push_back(std::make_unique<bpaccel::BinningMethod>(params, p));
 
@@ -99,10 +100,9 @@ int main(int argc, char** argv) {
     const double host = bpaccel::median(rows[k].host), dev = bpaccel::median(rows[k].device),
                  link = bpaccel::median(rows[k].link);
     fmt::print("accelerator binning on {}: frame {:.4f} ms = host {:.4f} ms (measured: plan {:.4f}, decode and recheck {:.4f}) + link {:.4f} ms (modelled) + "
-               "device {:.4f} ms (modelled)\n  platform: {}\n  clock: no place-and-route report of the binning design: "
-               "the stream device's with m = {} on that part stands in\n",
+               "device {:.4f} ms (modelled)\n  platform: {}\n  clock: {}\n",
                profiles[k].name, 1e3 * (host + dev + link), 1e3 * host, 1e3 * bpaccel::median(rows[k].plan),
-               1e3 * bpaccel::median(rows[k].collect), 1e3 * link, 1e3 * dev, profiles[k].summary(), lanes);
+               1e3 * bpaccel::median(rows[k].collect), 1e3 * link, 1e3 * dev, profiles[k].summary(), profiles[k].part.clockHz.source);
   }
   return 0;
 }

@@ -2,6 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
 #include "methods/binning_method.hpp"
 #include "scenes.hpp"
 
@@ -50,6 +57,43 @@ TEST(BinningMethod, FindsTheExactPairsAndCountsOnlyHostWorkAsHost) {
   EXPECT_GT(t.parts->deviceSeconds, 0);
   EXPECT_EQ(t.parts->stats.boxesSent, 500u);
   EXPECT_DOUBLE_EQ(t.seconds, t.parts->hostSeconds + t.parts->deviceSeconds + t.parts->transferSeconds);
+}
+
+TEST(BinningMethod, RunsAtTheBinningDesignsOwnClockWhereItsReportOnThePartIsValidElseTheStreamsStandsIn) {
+  const auto dir = std::filesystem::temp_directory_path() / ("binning-reports-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& name, const std::string& status, double mhz) {
+    std::ofstream(dir / name) << nlohmann::json{{"status", status}, {"result_valid", status == "ok"}, {"m", 64},
+                                                {"arch", "binning"}, {"key_width", 12}, {"ecp5", {{"fmax_mhz", mhz}}}}
+                                     .dump();
+  };
+  BinningParams params;  // 64 lanes, 12-bit keys: reports binning-m64[-lfe5um5g-85f].json
+  DeviceProfile fiveG = testProfile(), gen3 = testProfile();
+  fiveG.name = "ecp5-5g", fiveG.part.name = "LFE5UM5G-85F", fiveG.part.speedGrade = 8;
+  gen3.name = "gen3x8";
+  for (DeviceProfile* p : {&fiveG, &gen3}) p->part.clockHz = {83.8e6, Provenance::Measured, "the stream device's"};
+
+  // No reports: the stream device's clock stands in, and says which report is missing.
+  DeviceProfile b = binningProfile(fiveG, params, dir.string());
+  EXPECT_EQ(b.part.clockHz.value, 83.8e6);
+  EXPECT_EQ(b.part.clockHz.provenance, Provenance::StandIn);
+  EXPECT_NE(b.part.clockHz.source.find("binning-m64"), std::string::npos) << b.part.clockHz.source;
+  // A report of a design that does not fit: still the stand-in, naming the report.
+  write("binning-m64-lfe5um5g-85f.json", "does_not_fit", 0);
+  b = binningProfile(fiveG, params, dir.string());
+  EXPECT_EQ(b.part.clockHz.value, 83.8e6);
+  EXPECT_NE(b.part.clockHz.source.find("binning-m64-lfe5um5g-85f.json"), std::string::npos) << b.part.clockHz.source;
+  // A routed design on the 5G part: its own Fmax, measured; the gen3x8 card takes the LFE5U-85F's as a stand-in.
+  write("binning-m64-lfe5um5g-85f.json", "ok", 131.5);
+  write("binning-m64.json", "ok", 101.25);
+  b = binningProfile(fiveG, params, dir.string());
+  EXPECT_EQ(b.part.clockHz.value, 131.5e6);
+  EXPECT_EQ(b.part.clockHz.provenance, Provenance::Measured);
+  const DeviceProfile g = binningProfile(gen3, params, dir.string());
+  EXPECT_EQ(g.part.clockHz.value, 101.25e6);
+  EXPECT_EQ(g.part.clockHz.provenance, Provenance::StandIn);
+  EXPECT_EQ(g.link.effectiveBytesPerSecond.value, gen3.link.effectiveBytesPerSecond.value);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
