@@ -44,11 +44,12 @@ void BinningFrame::plan(std::span<const Aabb> boxes) {
   }
   if (whole.ids.size() <= p.boxCapacity) {  // the common frame: one device frame
     whole.grid = gridFor(p, bounds, cellEdge_);
+    whole.region = Region{};
     frames_.push_back(std::move(whole));
-    fillKeys(frames_.back(), 0, -HUGE_VAL, HUGE_VAL);
+    fillKeys(frames_.back());
     return;
   }
-  planSlabs(whole.ids, bounds);
+  planRegions(whole.ids, bounds);
   spare_.push_back(std::move(whole));
 }
 
@@ -75,36 +76,76 @@ AxisBounds BinningFrame::keepFitting(std::vector<std::uint32_t>& ids) {
   return bounds;
 }
 
-void BinningFrame::planSlabs(std::span<const std::uint32_t> ids, const AxisBounds& bounds) {
-  // Slabs along the longest axis, cut at quantiles of the mins, about 90 % of the capacity each.
+bool Region::bounded() const {
+  for (int a = 0; a < 3; ++a)
+    if (std::isfinite(lo[a]) || std::isfinite(hi[a])) return true;
+  return false;
+}
+
+bool Region::owns(const Aabb& a, const Aabb& b) const {
+  for (int x = 0; x < 3; ++x) {
+    const double corner = std::max(a.min[x], b.min[x]);
+    if (!(corner >= lo[x] && corner < hi[x])) return false;
+  }
+  return true;
+}
+
+void BinningFrame::planRegions(std::span<const std::uint32_t> ids, const AxisBounds& bounds) {
+  // About 90 % of the capacity a region, in a grid over the two longest axes, as square as the scene's
+  // extent on them allows: a thin slab spans few cells across, leaving lane groups idle while the
+  // memories of the others overflow.
   const BinningParams& p = device_.params();
-  int axis = 0;
-  for (int a = 1; a < 3; ++a) axis = bounds.hi[a] - bounds.lo[a] > bounds.hi[axis] - bounds.lo[axis] ? a : axis;
-  const std::size_t slabs = (ids.size() + p.boxCapacity * 9 / 10 - 1) / (p.boxCapacity * 9 / 10);
-  std::vector<float> mins;
-  mins.reserve(ids.size());
-  for (std::uint32_t i : ids) mins.push_back(boxes_[i].min[axis]);
-  // The cuts: the mins at the quantiles k / slabs, each found by a selection within the part above the last.
-  std::vector<double> cuts{-HUGE_VAL};
-  auto from = mins.begin();
-  for (std::size_t k = 1; k < slabs; ++k) {
-    const auto at = mins.begin() + static_cast<std::ptrdiff_t>(k * mins.size() / slabs);
-    std::nth_element(from, at, mins.end());
-    if (*at > cuts.back()) cuts.push_back(*at);
-    from = at;
+  const std::size_t regions = (ids.size() + p.boxCapacity * 9 / 10 - 1) / (p.boxCapacity * 9 / 10);
+  std::array<int, 3> axes{0, 1, 2};
+  const auto range = [&](int a) { return bounds.hi[a] - bounds.lo[a]; };
+  std::sort(axes.begin(), axes.end(), [&](int x, int y) { return range(x) > range(y); });
+  const double ratio = std::min(range(axes[0]) / std::max(range(axes[1]), 1e-300), 1e6);
+  const auto first = std::clamp<std::size_t>(
+      static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(regions) * ratio))), 1, regions);
+  const std::size_t second = (regions + first - 1) / first;
+  for (auto& [slabIds, slab] : cut(ids, Region{}, axes[0], first))
+    for (auto& [partIds, part] : cut(slabIds, slab, axes[1], second))
+      if (!partIds.empty()) frames_.push_back(makeFrame(std::move(partIds), part));
+}
+
+std::vector<std::pair<std::vector<std::uint32_t>, Region>> BinningFrame::cut(std::span<const std::uint32_t> ids,
+                                                                             const Region& outer, int axis,
+                                                                             std::size_t parts) {
+  // The cuts: near the quantiles k / parts of the mins, at the edges of a histogram's bins (one pass; any
+  // cut keeps the frame exact, the quantiles only balance the parts).
+  double least = HUGE_VAL, most = -HUGE_VAL;
+  for (std::uint32_t i : ids) least = std::min(least, double{boxes_[i].min[axis]}), most = std::max(most, double{boxes_[i].min[axis]});
+  std::vector<double> cuts{outer.lo[axis]};
+  constexpr std::size_t kBins = 4096;
+  if (parts > 1 && most > least && std::isfinite(most - least)) {
+    const double width = (most - least) / kBins;
+    std::vector<std::uint32_t> count(kBins + 1);
+    for (std::uint32_t i : ids)
+      count[std::min(kBins, static_cast<std::size_t>((boxes_[i].min[axis] - least) / width))] += 1;
+    std::size_t seen = 0, k = 1;
+    for (std::size_t bin = 0; bin <= kBins && k < parts; ++bin) {
+      seen += count[bin];
+      const double edge = least + static_cast<double>(bin + 1) * width;  // above every min of bins 0 .. bin
+      if (seen >= k * ids.size() / parts && edge > cuts.back() && edge < outer.hi[axis] && edge <= most) {
+        cuts.push_back(edge);
+        while (k < parts && seen >= k * ids.size() / parts) ++k;
+      }
+    }
   }
-  cuts.push_back(HUGE_VAL);
-  // Each box into every slab its extent on the axis meets: [lo, hi) meets [min, max] when min < hi and max >= lo.
-  std::vector<std::vector<std::uint32_t>> parts(cuts.size() - 1);
+  cuts.push_back(outer.hi[axis]);
+  std::vector<std::pair<std::vector<std::uint32_t>, Region>> out(cuts.size() - 1);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    out[k].first.reserve(ids.size() / out.size() + ids.size() / 8);  // a share, and room for the boxes across cuts
+    out[k].second = outer;
+    out[k].second.lo[axis] = cuts[k], out[k].second.hi[axis] = cuts[k + 1];
+  }
+  // Each box into every slab it meets, from the one holding its min (or the first) on.
   for (std::uint32_t i : ids) {
-    const auto last = std::upper_bound(cuts.begin(), cuts.end(), double{boxes_[i].max[axis]}) - cuts.begin() - 1;
-    for (auto k = std::lower_bound(cuts.begin() + 1, cuts.end(), double{boxes_[i].min[axis]},
-                                   [](double cut, double m) { return cut <= m; }) - cuts.begin() - 1;
-         k <= last; ++k)
-      parts[static_cast<std::size_t>(k)].push_back(i);
+    auto k = static_cast<std::size_t>(std::upper_bound(cuts.begin() + 1, cuts.end() - 1, double{boxes_[i].min[axis]}) -
+                                      cuts.begin() - 1);
+    for (; k < out.size() && out[k].second.meets(boxes_[i], axis); ++k) out[k].first.push_back(i);
   }
-  for (std::size_t k = 0; k < parts.size(); ++k)
-    if (!parts[k].empty()) frames_.push_back(makeFrame(std::move(parts[k]), axis, cuts[k], cuts[k + 1]));
+  return out;
 }
 
 PlannedFrame BinningFrame::takeSpare() {
@@ -114,16 +155,16 @@ PlannedFrame BinningFrame::takeSpare() {
   return f;
 }
 
-PlannedFrame BinningFrame::makeFrame(std::vector<std::uint32_t> ids, int axis, double lo, double hi) {
+PlannedFrame BinningFrame::makeFrame(std::vector<std::uint32_t> ids, const Region& region) {
   PlannedFrame f = takeSpare();
   f.grid = pickGrid(device_.params(), boxes_, ids, cellEdge_);
   f.ids = std::move(ids);
-  fillKeys(f, axis, lo, hi);
+  f.region = region;
+  fillKeys(f);
   return f;
 }
 
-void BinningFrame::fillKeys(PlannedFrame& f, int axis, double lo, double hi) {
-  f.axis = axis, f.lo = lo, f.hi = hi;
+void BinningFrame::fillKeys(PlannedFrame& f) {
   f.keys.resize(f.ids.size());
   if (quantizeAll(f.grid, boxes_, f.ids, f.keys)) [[likely]]
     return;
@@ -172,7 +213,7 @@ void BinningFrame::send() {
 }
 
 void BinningFrame::decode(const PlannedFrame& f, const FrameReply& r, std::vector<Pair>& out) {
-  const bool slabbed = std::isfinite(f.lo) || std::isfinite(f.hi);
+  const bool bounded = f.region.bounded();
   // The pairs come in the device's order, so the boxes are read at random: each read is asked for a few pairs ahead.
   constexpr std::size_t kAhead = 16;
   const std::size_t n = f.ids.size();
@@ -188,8 +229,7 @@ void BinningFrame::decode(const PlannedFrame& f, const FrameReply& r, std::vecto
       stats_.falsePositives += 1;
       continue;
     }
-    const double corner = std::max(a.min[f.axis], b.min[f.axis]);
-    if (slabbed && !(corner >= f.lo && corner < f.hi)) {
+    if (bounded && !f.region.owns(a, b)) {
       stats_.boundaryDrops += 1;
       continue;
     }
@@ -198,35 +238,27 @@ void BinningFrame::decode(const PlannedFrame& f, const FrameReply& r, std::vecto
 }
 
 bool BinningFrame::split(const PlannedFrame& f, std::vector<PlannedFrame>& todo) {
-  // A slab is cut on its own axis (its pairs are owned along it); the whole scene on its longest.
-  int axis = f.axis;
-  if (!std::isfinite(f.lo) && !std::isfinite(f.hi)) {
-    std::array<double, 3> range{};
-    for (int a = 0; a < 3; ++a) range[a] = f.grid.unit[a] * f.grid.dims[a];
-    axis = static_cast<int>(std::max_element(range.begin(), range.end()) - range.begin());
+  // On the axis where the frame's grid is longest first; another where all mins are equal there.
+  std::array<int, 3> axes{0, 1, 2};
+  const auto length = [&](int a) { return f.grid.unit[a] * f.grid.dims[a]; };
+  std::sort(axes.begin(), axes.end(), [&](int x, int y) { return length(x) > length(y); });
+  for (int axis : axes) {
+    auto halves = cut(f.ids, f.region, axis, 2);
+    // A cut helps when each half holds fewer boxes than the frame (all mins equal on the axis: none does).
+    const auto smaller = [&](const auto& half) { return !half.first.empty() && half.first.size() < f.ids.size(); };
+    if (halves.size() < 2 || !std::all_of(halves.begin(), halves.end(), smaller)) continue;
+    for (auto& [ids, region] : halves) todo.push_back(makeFrame(std::move(ids), region));
+    return true;
   }
-  std::vector<double> mins;
-  for (std::uint32_t i : f.ids) mins.push_back(boxes_[i].min[axis]);
-  std::nth_element(mins.begin(), mins.begin() + mins.size() / 2, mins.end());
-  const double cut = mins[mins.size() / 2];
-  if (!(cut > f.lo) || !(cut < f.hi)) return false;
-  for (auto [lo, hi] : {std::pair{f.lo, cut}, std::pair{cut, f.hi}}) {
-    std::vector<std::uint32_t> part;
-    for (std::uint32_t i : f.ids)
-      if (boxes_[i].min[axis] < hi && boxes_[i].max[axis] >= lo) part.push_back(i);
-    if (part.empty()) continue;
-    todo.push_back(makeFrame(std::move(part), axis, lo, hi));
-  }
-  return true;
+  return false;
 }
 
 void BinningFrame::hostPairs(const PlannedFrame& f) {
-  // A slab the device cannot hold and that cannot be cut: all its pairs on the host, its ownership rule kept.
+  // A region the device cannot hold and that cannot be cut: all its pairs on the host, its ownership rule kept.
   for (std::size_t x = 0; x < f.ids.size(); ++x)
     for (std::size_t y = x + 1; y < f.ids.size(); ++y) {
       const Aabb &a = boxes_[f.ids[x]], &b = boxes_[f.ids[y]];
-      const double corner = std::max(a.min[f.axis], b.min[f.axis]);
-      if (overlaps(a, b) && corner >= f.lo && corner < f.hi) hostPairs_.push_back(ordered(f.ids[x], f.ids[y]));
+      if (overlaps(a, b) && f.region.owns(a, b)) hostPairs_.push_back(ordered(f.ids[x], f.ids[y]));
     }
 }
 

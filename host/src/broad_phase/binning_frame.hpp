@@ -3,6 +3,7 @@
 // the device's global pairs decoded and rechecked with the float boxes.
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -15,27 +16,38 @@ namespace bpaccel {
 
 /// What the last frame cost, counted as the device and the link would see it.
 struct BinningFrameStats {
-  std::size_t slabs = 0;           // device frames that returned pairs
+  std::size_t slabs = 0;           // device frames that returned pairs (one a region)
   std::size_t retries = 0;         // frames the device refused for room (then cut in two)
   std::size_t boxesSent = 0;       // boxes over the link, summed over the frames sent
   std::size_t hostBoxes = 0;       // boxes too long for the grid, tested on the host
   std::size_t devicePairs = 0;     // pairs the device sent back
   std::size_t falsePositives = 0;  // of them, dropped by the float recheck (quantization)
-  std::size_t boundaryDrops = 0;   // of them, owned by a neighbouring slab
+  std::size_t boundaryDrops = 0;   // of them, owned by a neighbouring region
   std::uint64_t deviceCycles = 0;  // summed over the frames sent, refused ones too
   std::uint64_t issueCycles = 0;
   FramePhases phases;              // summed over the frames that returned pairs
 };
 
+/// A part of space, [lo, hi) on each axis (unbounded: the infinities). It
+/// owns the pairs whose intersection's low corner (the greater min on each
+/// axis) lies in it: regions that tile space own each pair once.
+struct Region {
+  std::array<double, 3> lo{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  std::array<double, 3> hi{HUGE_VAL, HUGE_VAL, HUGE_VAL};
+  bool bounded() const;
+  /// Whether the region owns the pair of overlapping boxes a, b.
+  bool owns(const Aabb& a, const Aabb& b) const;
+  /// Whether box b meets the region on `axis`: [lo, hi) meets [min, max] when min < hi and max >= lo.
+  bool meets(const Aabb& b, int axis) const { return b.min[axis] < hi[axis] && b.max[axis] >= lo[axis]; }
+};
+
 /// One device frame of the plan: the boxes it carries (global ids, in stream
-/// order) with their keys, its grid, and the slab [lo, hi) on `axis` whose
-/// pairs it owns (a pair is owned where the low corner of its intersection lies).
+/// order) with their keys, its grid, and the region whose pairs it owns.
 struct PlannedFrame {
   std::vector<std::uint32_t> ids;
   std::vector<KeyBox> keys;
   KeyGrid grid;
-  int axis = 0;
-  double lo = -1.0 / 0.0, hi = 1.0 / 0.0;
+  Region region;
 };
 
 /// Finds every overlapping pair of float boxes exactly once on a FrameDevice:
@@ -46,12 +58,14 @@ struct PlannedFrame {
 /// - the keys: rounded outwards (quantize), so the device's pairs are a
 ///   superset, and each is rechecked with the float boxes (inclusive, as
 ///   overlaps() on keys);
-/// - slabs: a scene above the box capacity is cut along its longest axis at
-///   quantiles of the boxes' mins; a box meeting several slabs goes to each,
-///   and a pair is kept only by the slab holding its intersection's low
-///   corner on that axis. A frame the device refuses for room (GROUP_OVERFLOW,
-///   COUNT_OVER_CAPACITY) is cut in two and sent again; a slab that cannot be
-///   cut (all mins equal) is tested on the host.
+/// - regions: a scene above the box capacity is cut into a grid of regions
+///   over its two longest axes, at quantiles of the boxes' mins (on the first
+///   axis, then within each of its slabs on the second), so that each region
+///   spans enough cells on both to use all the device's lane groups; a box
+///   meeting several regions goes to each, and a pair is kept only by the
+///   region holding its intersection's low corner. A frame the device refuses
+///   for room (GROUP_OVERFLOW, COUNT_OVER_CAPACITY) is cut in two and sent
+///   again; a region that cannot be cut (all mins equal) is tested on the host.
 class BinningFrame {
  public:
   explicit BinningFrame(FrameDevice& device) : device_(device) {}
@@ -70,17 +84,21 @@ class BinningFrame {
  private:
   /// The boxes within the cell edge into `ids`, the others to the host's path; returns the bounds of `ids`.
   AxisBounds keepFitting(std::vector<std::uint32_t>& ids);
-  /// Cuts the scene's fitting boxes `ids` (within `bounds`) into slabs, each a frame of frames_.
-  void planSlabs(std::span<const std::uint32_t> ids, const AxisBounds& bounds);
+  /// Cuts the scene's fitting boxes `ids` (within `bounds`) into regions, each a frame of frames_.
+  void planRegions(std::span<const std::uint32_t> ids, const AxisBounds& bounds);
+  /// Cuts `outer` on `axis` into up to `parts` slabs at quantiles of the mins of `ids`: their boxes (each
+  /// in every slab it meets) and their regions.
+  std::vector<std::pair<std::vector<std::uint32_t>, Region>> cut(std::span<const std::uint32_t> ids,
+                                                                  const Region& outer, int axis, std::size_t parts);
   /// A frame of spare_, its buffers' capacity kept from an earlier frame, or a new one.
   PlannedFrame takeSpare();
-  /// The frame of boxes `ids` owning [lo, hi) on `axis`, with its grid and keys.
-  PlannedFrame makeFrame(std::vector<std::uint32_t> ids, int axis, double lo, double hi);
+  /// The frame of boxes `ids` owning `region`, with its grid and keys.
+  PlannedFrame makeFrame(std::vector<std::uint32_t> ids, const Region& region);
   /// f's keys on its grid, for its ids; a box whose keys span more than two cells goes to the host's path.
-  void fillKeys(PlannedFrame& f, int axis, double lo, double hi);
+  void fillKeys(PlannedFrame& f);
   /// The frame's global pairs, kept where the float boxes overlap and the slab owns them.
   void decode(const PlannedFrame& f, const FrameReply& r, std::vector<Pair>& out);
-  /// Cuts a refused frame in two at its boxes' median min; false if it cannot be cut.
+  /// Cuts a refused frame's region in two at its boxes' median min on an axis; false if none can be cut.
   bool split(const PlannedFrame& f, std::vector<PlannedFrame>& todo);
   void hostPairs(const PlannedFrame& f);
   void longBoxPairs(std::vector<Pair>& out) const;
@@ -93,7 +111,7 @@ class BinningFrame {
   std::vector<FrameReply> replies_;  // send's, one per frame of frames_ that returned pairs
   std::vector<std::uint32_t> longIds_;
   std::vector<std::uint8_t> isLong_;
-  std::vector<Pair> hostPairs_;  // of slabs no cut could shrink
+  std::vector<Pair> hostPairs_;  // of regions no cut could shrink
   BinningFrameStats stats_;
 };
 

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "broad_phase/binning_frame.hpp"
@@ -44,15 +45,24 @@ TEST(BinningFrame, FindsExactlyTheFloatPairsOnAdversarialScenes) {
     }
 }
 
-TEST(BinningFrame, CutsScenesAboveTheCapacityIntoSlabsAndKeepsEachBoundaryPairOnce) {
+TEST(BinningFrame, CutsScenesAboveTheCapacityIntoRegionsOnTwoAxesAndKeepsEachBoundaryPairOnce) {
   BinningModel small(smallDevice());
   for (unsigned seed = 0; seed < 6; ++seed) {
     const auto boxes = testing::scatteredBoxes(400 + 100 * seed, seed, 0, 40, 0.1f, 3.0f);
-    BinningFrameStats stats;
-    EXPECT_EQ(framePairs(small, boxes, &stats), bruteForce(boxes)) << "seed " << seed;
+    BinningFrame frame(small);
+    std::vector<Pair> out;
+    frame.findPairs(boxes, out);
+    EXPECT_EQ(sorted(out), bruteForce(boxes)) << "seed " << seed;
+    const BinningFrameStats& stats = frame.stats();
     EXPECT_GE(stats.slabs, 4u);
-    EXPECT_GT(stats.boundaryDrops, 0u) << "no pair was found by two slabs: the boundary rule went untested";
-    EXPECT_GT(stats.boxesSent, boxes.size()) << "no box straddled a slab boundary";
+    EXPECT_GT(stats.boundaryDrops, 0u) << "no pair was found by two regions: the boundary rule went untested";
+    EXPECT_GT(stats.boxesSent, boxes.size()) << "no box straddled a region boundary";
+    // A grid of regions over two axes (and cut again on refusal): no region is a slab across the whole scene.
+    for (const PlannedFrame& f : frame.frames()) {
+      int bounded = 0;
+      for (int a = 0; a < 3; ++a) bounded += std::isfinite(f.region.lo[a]) || std::isfinite(f.region.hi[a]);
+      EXPECT_GE(bounded, 2) << "seed " << seed;
+    }
   }
 }
 
