@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "model/fpga_report.hpp"
+#include "bpaccel_shell.h"
 
 namespace bpaccel {
 
@@ -28,10 +29,37 @@ BinningFrameModel modelBinningFrame(const BinningFrameStats& stats, const Binnin
   return m;
 }
 
-FrameReply TimedFrameDevice::runFrame(const FrameCommand& command) {
+ShellFormat binningShellFormat(const BinningParams& params) {
+  ShellFormat f;
+  f.wordsPerBeat = 8;
+  f.keyWidth = params.keyWidth;
+  f.boxWords = params.keyWidth <= 16 ? 3 : 6;
+  f.indexWidth = params.indexWidth();
+  f.indexWords = params.indexWidth() <= 16 ? 1 : 2;
+  f.lanes = params.lanes();
+  f.capacity = params.boxCapacity;
+  f.bipartite = false;
+  f.cellBits = params.cellBits;
+  return f;
+}
+
+FrameReply ModelledFrameCard::runFrame(const FrameCommand& command) {
+  encodeFrame(format_, command.boxes, FrameGrid{command.shift, command.dims}, packet_);  // the driver's
   const auto t0 = std::chrono::steady_clock::now();
   FrameReply r = inner_.runFrame(command);
+  // The reply's words as the card sends them: a record a pair, whole beats, then the trailer.
+  reply_.clear();
+  for (const auto& [i, j] : r.pairs)
+    if (format_.indexWords == 1) reply_.push_back(j << 16 | i);
+    else reply_.push_back(i), reply_.push_back(j);
+  reply_.resize(format_.paddedWords(reply_.size()) + BPACCEL_SHELL_TRAILER_WORDS);
   seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (r.error != FrameError::None) return r;  // the driver reads an error trailer's code, never its records
+  Trailer trailer;
+  trailer.records = static_cast<std::uint32_t>(r.pairs.size());
+  trailer.pairs = r.pairs.size();
+  r.pairs.clear();
+  decodeFrameReply(format_, reply_, trailer, command.count(), r.pairs);  // the driver's
   return r;
 }
 
@@ -49,8 +77,8 @@ void BinningMethod::update(std::span<const Aabb> boxes) {
   const auto t2 = Clock::now();
   frame_.collect(pairs_);
   const auto t3 = Clock::now();
-  planSeconds_ = seconds(t0, t1), collectSeconds_ = seconds(t2, t3);
   simulationSeconds_ = timed_.seconds;  // the model stands in for the card: its time is not host work
+  planSeconds_ = seconds(t0, t1), driverSeconds_ = seconds(t1, t2) - simulationSeconds_, collectSeconds_ = seconds(t2, t3);
 }
 
 FrameTime BinningMethod::frameTime(double measuredSeconds) const {

@@ -9,6 +9,7 @@
 
 #include "broad_phase/binning_frame.hpp"
 #include "device/binning/binning_model.hpp"
+#include "device/rtl/shell/frame_codec.hpp"
 #include "model/device_profile.hpp"
 #include "timed_method.hpp"
 
@@ -32,11 +33,18 @@ struct BinningFrameModel {
 BinningFrameModel modelBinningFrame(const BinningFrameStats& stats, const BinningParams& params,
                                     const DeviceProfile& profile);
 
-/// A FrameDevice that passes each frame on and adds up the time it took: the
-/// model's own run, which stands in for the card and is no host work.
-class TimedFrameDevice final : public FrameDevice {
+/// The shell's packet layout for the binning device `params` on a 256-bit
+/// stream (docs/protocol.md): what its driver encodes and decodes.
+ShellFormat binningShellFormat(const BinningParams& params);
+
+/// The card as the bench models it, in front of a FrameDevice model: the
+/// driver's work on the host runs for real (each frame's FRAME packet encoded,
+/// the reply's records decoded into the pairs the model found), and the
+/// card's own work (the model's run, the reply's words it sends) is timed
+/// apart in `seconds`, which is no host work.
+class ModelledFrameCard final : public FrameDevice {
  public:
-  explicit TimedFrameDevice(FrameDevice& inner) : inner_(inner) {}
+  explicit ModelledFrameCard(FrameDevice& inner) : inner_(inner), format_(binningShellFormat(inner.params())) {}
   std::string name() const override { return inner_.name(); }
   const BinningParams& params() const override { return inner_.params(); }
   FrameReply runFrame(const FrameCommand& command) override;
@@ -44,6 +52,8 @@ class TimedFrameDevice final : public FrameDevice {
 
  private:
   FrameDevice& inner_;
+  ShellFormat format_;
+  std::vector<std::uint32_t> packet_, reply_;
 };
 
 /// "accelerator binning on <profile>": BinningFrame on a BinningModel.
@@ -57,17 +67,18 @@ class BinningMethod final : public TimedMethod {
   FrameTime frameTime(double measuredSeconds) const override;
   const BinningFrameStats& stats() const { return frame_.stats(); }
   const BinningFrame& frame() const { return frame_; }
-  /// The last update's measured host parts: plan (checks, grid, keys, slabs) and collect (decode, recheck);
-  /// the host's work inside send (cutting refused frames again) is in neither but in the host's total.
+  /// The last update's measured host parts: plan (checks, grid, keys, regions), the driver's (the packets
+  /// encoded, the replies' records decoded, refused frames cut again) and collect (decode, recheck).
   double planSeconds() const { return planSeconds_; }
+  double driverSeconds() const { return driverSeconds_; }
   double collectSeconds() const { return collectSeconds_; }
 
  private:
   BinningModel device_;
-  TimedFrameDevice timed_;
+  ModelledFrameCard timed_;
   BinningFrame frame_;
   DeviceProfile profile_;
-  double simulationSeconds_ = 0, planSeconds_ = 0, collectSeconds_ = 0;
+  double simulationSeconds_ = 0, planSeconds_ = 0, driverSeconds_ = 0, collectSeconds_ = 0;
   std::vector<Pair> pairs_;
 };
 

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -94,6 +95,24 @@ TEST(BinningMethod, RunsAtTheBinningDesignsOwnClockWhereItsReportOnThePartIsVali
   EXPECT_EQ(g.part.clockHz.provenance, Provenance::StandIn);
   EXPECT_EQ(g.link.effectiveBytesPerSecond.value, gen3.link.effectiveBytesPerSecond.value);
   std::filesystem::remove_all(dir);
+}
+
+TEST(BinningMethod, TheModelledCardRunsTheDriversEncodingAndDecodingAndReturnsTheModelsPairs) {
+  BinningModel model(builtBinningParams()), inner(builtBinningParams());
+  ModelledFrameCard card(inner);
+  BinningFrame direct(model), driven(card);
+  const auto boxes = testing::scatteredBoxes(3000, 4, 0, 40, 0.3f, 2.5f);
+  std::vector<Pair> a, b;
+  direct.findPairs(boxes, a);
+  driven.findPairs(boxes, b);
+  std::sort(a.begin(), a.end()), std::sort(b.begin(), b.end());
+  EXPECT_EQ(a, b);
+  EXPECT_GT(b.size(), 0u);
+  EXPECT_EQ(driven.stats().deviceCycles, direct.stats().deviceCycles);
+  EXPECT_GT(card.seconds, 0.0);
+  // A key wider than the device's is the driver's to refuse, before the card sees it.
+  std::vector<KeyBox> wide(1, KeyBox{{0, 0, 0}, {1u << 20, 1, 1}});
+  EXPECT_THROW(card.runFrame(FrameCommand{wide, 0, {1, 1, 1}, std::nullopt}), std::invalid_argument);
 }
 
 }  // namespace

@@ -71,7 +71,7 @@ void encodeCells(const ShellFormat& format, const CellsCommand& command, std::ve
   for (std::size_t k = 0; k < cells.size(); ++k) {
     packet.push_back(static_cast<std::uint32_t>(cells[k].size()));
     packet.push_back(static_cast<std::uint32_t>(command.split(k)));
-    for (const KeyBox& box : cells[k]) shell_words::appendBox(format, box, packet);
+    shell_words::appendBoxes(format, cells[k], packet);
   }
   shell_words::padToBeats(format, packet);
 }

@@ -29,7 +29,7 @@ void encodeFrame(const ShellFormat& format, std::span<const KeyBox> boxes, const
   packet.push_back(static_cast<std::uint32_t>(boxes.size()));
   packet.push_back(grid.shift);
   packet.push_back(grid.cells[0] | grid.cells[1] << 8 | grid.cells[2] << 16);
-  for (const KeyBox& box : boxes) shell_words::appendBox(format, box, packet);
+  shell_words::appendBoxes(format, boxes, packet);
   shell_words::padToBeats(format, packet);
 }
 

@@ -10,12 +10,21 @@ namespace bpaccel::shell_words {
 
 std::uint32_t commandHeader(std::uint32_t opcode) { return opcode | (BPACCEL_SHELL_PROTOCOL_VERSION << 8); }
 
-void appendBox(const ShellFormat& format, const KeyBox& box, std::vector<std::uint32_t>& packet) {
+void appendBoxes(const ShellFormat& format, std::span<const KeyBox> boxes, std::vector<std::uint32_t>& packet) {
+  // Sized once and written through a pointer: a frame's thousands of boxes are most of its packet.
+  const std::size_t at = packet.size();
+  packet.resize(at + boxes.size() * format.boxWords);
+  std::uint32_t* out = packet.data() + at;
   if (format.boxWords == 6) {
-    packet.insert(packet.end(), {box.min[0], box.min[1], box.min[2], box.max[0], box.max[1], box.max[2]});
+    for (const KeyBox& b : boxes) {
+      out[0] = b.min[0], out[1] = b.min[1], out[2] = b.min[2], out[3] = b.max[0], out[4] = b.max[1], out[5] = b.max[2];
+      out += 6;
+    }
   } else {
-    packet.insert(packet.end(), {box.min[0] | box.min[1] << 16, box.min[2] | box.max[0] << 16,
-                                 box.max[1] | box.max[2] << 16});
+    for (const KeyBox& b : boxes) {
+      out[0] = b.min[0] | b.min[1] << 16, out[1] = b.min[2] | b.max[0] << 16, out[2] = b.max[1] | b.max[2] << 16;
+      out += 3;
+    }
   }
 }
 

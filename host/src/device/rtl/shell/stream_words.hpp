@@ -17,9 +17,10 @@ namespace bpaccel::shell_words {
 /// Word 0 of a command: the opcode in bits [7:0], the protocol version in [15:8].
 std::uint32_t commandHeader(std::uint32_t opcode);
 
-/// Appends one box: six keys, a word each, or two a word (the low half
-/// first) where keys have 16 bits or fewer. The caller has checked the keys (keysFit).
-void appendBox(const ShellFormat& format, const KeyBox& box, std::vector<std::uint32_t>& packet);
+/// Appends the boxes: six keys a box, a word each, or two a word (the low
+/// half first) where keys have 16 bits or fewer. The caller has checked the
+/// keys (checkKeys).
+void appendBoxes(const ShellFormat& format, std::span<const KeyBox> boxes, std::vector<std::uint32_t>& packet);
 
 /// Whether no key of `boxes` has a bit set above the format's key width; else
 /// throws std::invalid_argument naming `where`, the box (its index plus
