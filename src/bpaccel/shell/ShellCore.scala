@@ -142,6 +142,9 @@ class ShellCore(p: ShellParams) extends Module {
     summary   := adapter.io.summary.bits
     summaryIn := true.B
     running   := false.B
+    // The core's error names content before anything found after it (a summary after a cancel carries none).
+    val coreError = adapter.io.summary.bits.error
+    when(coreError.code =/= 0.U) { error := coreError.code; detail := coreError.detail }
   }
 
   // The trailer (docs/protocol.md).
