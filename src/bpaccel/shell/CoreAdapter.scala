@@ -41,13 +41,17 @@ class ItemError extends Bundle {
   * `cancel` (an error or an abort) the adapter stops its core and reports
   * its summary at once; otherwise it reports it after its last record, with
   * the first error its core found in the body, if any (it names content
-  * that came before anything the control could find wrong afterwards).
+  * that came before anything the control could find wrong afterwards). A
+  * cancel with `ended` (the packet ended before the body's last item) may
+  * instead end the core's command on the words that came whole, and report
+  * the summary, with the core's error, when the core does.
   */
 class AdapterIO(p: ShellParams, recordWords: Int) extends Bundle {
   val start     = Input(Bool())
   val window    = Input(new WordWindow(p))
   val take      = Input(Bool())
   val cancel    = Input(Bool())
+  val ended     = Input(Bool())
   val need      = Output(UInt(log2Ceil(p.itemWords + 1).W))
   val last      = Output(Bool())
   val ready     = Output(Bool())

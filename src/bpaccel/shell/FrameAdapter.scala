@@ -22,16 +22,25 @@ import bpaccel.binning.{BinningCore, BinningError, BoxBeat, FrameHeader}
   * max x 0), and its BOX_INVERTED at that box is reported as KEY_TOO_WIDE; a
   * header with a reserved bit set reaches it with shift 255 (BAD_GRID).
   *
+  * A packet that ends before the n-th box (`cancel` with `ended`) ends the
+  * core's frame with a last beat of the boxes that came whole: the core then
+  * reports LENGTH_MISMATCH naming them, unless a box before them erred. Any
+  * other cancel (an abort, an error in the header) aborts the core; the
+  * summary then counts the records and boxes so far and no cycles.
+  *
   * Each of the core's pairs is a record ({j, i} or i, j), all pairs of a core
-  * beat in one cycle. An abort (`cancel`) aborts the core; the summary then
-  * counts the records and boxes so far and no cycles.
+  * beat in one cycle.
   */
 class FrameAdapter(p: ShellParams) extends CoreAdapter(p, p.binning.get.pairsPerBeat * p.indexWords) {
   val opcode = Protocol.Frame
   private val b = p.binning.get
   private val w = b.intakeBoxes
 
-  val cancelling = RegNext(io.cancel, false.B)
+  object Phase extends ChiselEnum { val Idle, Header, Boxes, Finishing = Value }
+  val phase = RegInit(Phase.Idle)
+
+  private val endsShort = io.cancel && io.ended && phase === Phase.Boxes
+  val cancelling = RegNext(io.cancel && !endsShort, false.B)
   // The core aborts (and restarts) and its queues empty on a cancel: nothing of the command is left.
   val core = Module(new BinningCore(b))
   core.io.abort := cancelling
@@ -41,8 +50,6 @@ class FrameAdapter(p: ShellParams) extends CoreAdapter(p, p.binning.get.pairsPer
   core.io.frame <> headers.io.deq
   core.io.boxes <> beats.io.deq
 
-  object Phase extends ChiselEnum { val Idle, Header, Boxes, Finishing = Value }
-  val phase        = RegInit(Phase.Idle)
   val boxesLeft    = Reg(UInt(32.W))
   val boxesIn      = Reg(UInt(32.W))
   val records      = Reg(UInt(32.W))
@@ -57,7 +64,6 @@ class FrameAdapter(p: ShellParams) extends CoreAdapter(p, p.binning.get.pairsPer
   // Boxes: this item's count and their decoded keys.
   private val itemBoxes = Mux(boxesLeft >= w.U, w.U, boxesLeft)
   private val decoded   = Seq.tabulate(w)(l => StreamBox.decode(p, words.slice(l * p.boxWords, (l + 1) * p.boxWords)))
-  private val tooWide   = decoded.zipWithIndex.map { case (d, l) => d.tooWide && l.U < itemBoxes }
 
   io.need := Mux(phase === Phase.Header, p.frameHeaderWords.U,
     MuxLookup(itemBoxes, 0.U)((1 to w).map(k => k.U -> (k * p.boxWords).U)))
@@ -80,16 +86,25 @@ class FrameAdapter(p: ShellParams) extends CoreAdapter(p, p.binning.get.pairsPer
   headers.io.enq.bits.shift := Mux(reserved, 255.U, words(1)(7, 0))
   headers.io.enq.bits.dims  := VecInit((0 until 3).map(a => words(2)(8 * a + 7, 8 * a)))
 
-  beats.io.enq.valid     := io.take && (phase === Phase.Boxes || noBoxes)
-  beats.io.enq.bits.last := phase === Phase.Header || boxesLeft <= w.U
-  for ((lane, l) <- beats.io.enq.bits.boxes.zipWithIndex) {
-    lane.valid := phase === Phase.Boxes && l.U < itemBoxes
+  // The beat of this item; after a short end, the boxes that came whole, kept until the queue has room.
+  private val beat = Wire(new BoxBeat(b))
+  private val boxesNow = Mux(io.ended, wholeUpTo, itemBoxes)
+  beat.last := phase === Phase.Header || boxesLeft <= w.U || io.ended
+  for ((lane, l) <- beat.boxes.zipWithIndex) {
+    lane.valid := phase === Phase.Boxes && l.U < boxesNow
     lane.bits  := decoded(l).aabb
     when(decoded(l).tooWide) { // inverted on x: the core's BOX_INVERTED at this box
       lane.bits.min(0) := Fill(b.keyWidth, 1.U(1.W))
       lane.bits.max(0) := 0.U
     }
   }
+  val lastBeat = RegInit(0.U.asTypeOf(Valid(new BoxBeat(b))))
+  when(endsShort) { lastBeat.valid := true.B; lastBeat.bits := beat }
+  when(lastBeat.valid && beats.io.enq.ready) { lastBeat.valid := false.B }
+  when(cancelling) { lastBeat.valid := false.B }
+  beats.io.enq.valid := io.take && (phase === Phase.Boxes || noBoxes) || lastBeat.valid
+  beats.io.enq.bits  := Mux(lastBeat.valid, lastBeat.bits, beat)
+  assert(!(lastBeat.valid && io.take), "an item was taken after the packet ended")
   assert(!headers.io.enq.valid || headers.io.enq.ready, "a frame header was taken without room")
   assert(!beats.io.enq.valid || beats.io.enq.ready, "boxes were taken without room")
 
@@ -98,6 +113,12 @@ class FrameAdapter(p: ShellParams) extends CoreAdapter(p, p.binning.get.pairsPer
     Seq(boxesIn, records).foreach(_ := 0.U)
     firstTooWide.valid := false.B
   }
+  private val tooWideNow = decoded.zipWithIndex.map { case (d, l) => d.tooWide && l.U < boxesNow }
+  when((io.take && phase === Phase.Boxes || endsShort) && !firstTooWide.valid && tooWideNow.reduce(_ || _)) {
+    firstTooWide.valid := true.B
+    firstTooWide.bits  := boxesIn + PriorityEncoder(tooWideNow)
+  }
+  when(endsShort) { boxesIn := boxesIn + wholeUpTo }
   when(io.take) {
     switch(phase) {
       is(Phase.Header) {
@@ -108,10 +129,6 @@ class FrameAdapter(p: ShellParams) extends CoreAdapter(p, p.binning.get.pairsPer
         boxesLeft := boxesLeft - itemBoxes
         boxesIn   := boxesIn + itemBoxes
         when(boxesLeft <= w.U) { phase := Phase.Finishing }
-        when(!firstTooWide.valid && tooWide.reduce(_ || _)) {
-          firstTooWide.valid := true.B
-          firstTooWide.bits  := boxesIn + PriorityEncoder(tooWide)
-        }
       }
     }
   }

@@ -131,17 +131,24 @@ class FrameShellSpec extends AnyFlatSpec with Simulators with Matchers {
     }
   }
 
-  it should "report a packet cut short as LENGTH_MISMATCH, naming the boxes it carried (padding words read as boxes)" in {
+  it should "report a packet cut short as LENGTH_MISMATCH naming the boxes it carried, unless a box before the cut erred" in {
     val rng = new Random(6)
     val (shift, dims) = (3, Seq(4, 4, 2))
     val boxes = BinScenes.uniform(rng, 12, shift, dims)
+    val outside = Box(Seq(0, 0, 0).map(BigInt(_)), Seq(BigInt(0), BigInt(4 << shift), BigInt(0)))
+    val wide = Box(Seq(0, 0, 0).map(BigInt(_)), Seq(BigInt(1), BigInt(1), BigInt(1) << binning.keyWidth))
+    // 4 + 3m words padded to beats of 4: m = 7 leaves 3 zero words, which read as one more box.
+    val cases = Seq(0, 1, 5, 6, 7, 8).map(m => (s"$m boxes of 12", boxes.take(m), if (m == 7) 8L else m.toLong, "LENGTH_MISMATCH")) ++ Seq(
+      ("6 boxes of 12, box 2 out of the grid", boxes.take(6).updated(2, outside), 2L, "KEY_OUT_OF_GRID"),
+      ("5 boxes of 12, box 4 too wide (the cut's beat)", boxes.take(5).updated(4, wide), 4L, "KEY_TOO_WIDE"),
+      ("9 boxes of 12, box 8 too wide and box 1 out of the grid", boxes.take(9).updated(8, wide).updated(1, outside), 1L, "KEY_OUT_OF_GRID")
+    )
     onShell(4) { d =>
-      // 4 + 3m words padded to beats of 4: m = 7 leaves 3 zero words, which read as one more box.
-      for ((sent, carried) <- Seq(0 -> 0, 1 -> 1, 5 -> 5, 6 -> 6, 7 -> 8, 8 -> 8)) withClue(s"$sent boxes of 12: ") {
+      for ((name, sent, detail, expected) <- cases) withClue(s"$name: ") {
         val next = BinFrame(boxes.take(9), shift, dims)
-        val Seq(bad, after) = d.exchange(Seq(FrameWords.frame(p, boxes.take(sent), shift, dims, n = Some(12)), frameWords(next)),
+        val Seq(bad, after) = d.exchange(Seq(FrameWords.frame(p, sent, shift, dims, n = Some(12)), frameWords(next)),
           inGap = 0.3, outStall = 0.3)
-        checkError(bad, "LENGTH_MISMATCH", carried)
+        checkError(bad, expected, detail)
         checkFrame(next, after)
       }
       // A header cut short: TLAST inside it.
