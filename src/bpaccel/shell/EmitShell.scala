@@ -73,13 +73,16 @@ object EmitShell {
     targetDir: Path = Paths.get("build/shell"),
     smokeTestbench: Option[Path] = None
   ) {
-    def core: ShellCoreParams =
+    def core: ShellCoreParams = {
+      val archs = Arch.all.map(_.name) :+ "binning"
+      require(archs.contains(arch), s"arch must be one of ${archs.mkString(", ")}, got arch = $arch")
       if (arch == "binning")
         binning.copy(boxCapacity = capacity.getOrElse(binning.boxCapacity), keyWidth = keyWidth.getOrElse(binning.keyWidth),
           memoryStyle = MemoryStyle.fromName(memoryStyle))
       else
         AccelParams(m = m, capacity = capacity.getOrElse(Arch.fromName(arch).defaultCapacity(m)), keyWidth = keyWidth.getOrElse(32),
           arch = Arch.fromName(arch), batchCells = batchCells, memoryStyle = MemoryStyle.fromName(memoryStyle))
+    }
     def params: ShellParams = ShellParams(core, streamBits, dualClock, fifoDepth)
   }
 
