@@ -8,18 +8,31 @@ SHELL_M        ?= 8
 SHELL_CAPACITY ?= 64
 SHELL_STREAM_BITS ?= 128
 SHELL_DUAL_CLOCK  ?= true
-SHELL_DIR      ?= build/shell/$(SHELL_ARCH)-m$(SHELL_M)-w$(SHELL_STREAM_BITS)
+# SHELL_ARCH=binning: the binning core, its parameters in SHELL_BINNING (EmitShell's --group-bits,
+# --lanes-per-group, --cell-bits, --capacity (boxes a frame), --group-capacity, --key-width,
+# --intake-boxes, --pairs-per-beat; empty: BinningParams' defaults); SHELL_M and SHELL_CAPACITY are the CELLS cores'.
+SHELL_BINNING  ?=
 SHELL_TESTBENCH := test/fusesoc/bpaccel_shell_smoke_tb.sv
+ifeq ($(SHELL_ARCH),binning)
+SHELL_DIR      ?= build/shell/binning-w$(SHELL_STREAM_BITS)
+SHELL_CORE_ARGS := $(SHELL_BINNING)
+SHELL_CORE_TOP  := BinningCore
+else
+SHELL_DIR      ?= build/shell/$(SHELL_ARCH)-m$(SHELL_M)-w$(SHELL_STREAM_BITS)
+# The FuseSoC smoke testbench sends CELLS commands.
+SHELL_CORE_ARGS := --m $(SHELL_M) --capacity $(SHELL_CAPACITY) --smoke-testbench $(SHELL_TESTBENCH)
+SHELL_CORE_TOP  := BroadPhaseAccel
+endif
 SHELL_VENV     := build/shell-venv/bin
 
-# SystemVerilog, bpaccel_params.h, bpaccel_shell.h, bpaccel_shell.rdl, registers.md, bpaccel_shell.core,
-# and the registers as IP-XACT (bpaccel_shell_registers.xml, from the SystemRDL by PeakRDL).
+# SystemVerilog, the core's C header and JSON parameters, bpaccel_shell.h, bpaccel_shell.rdl, registers.md,
+# bpaccel_shell.core, and the registers as IP-XACT (bpaccel_shell_registers.xml, from the SystemRDL by PeakRDL).
 shell-verilog: deps
-	$(SBT) "runMain bpaccel.shell.EmitShell --arch $(SHELL_ARCH) --m $(SHELL_M) --capacity $(SHELL_CAPACITY) --stream-bits $(SHELL_STREAM_BITS) --dual-clock $(SHELL_DUAL_CLOCK) --target-dir $(SHELL_DIR) --smoke-testbench $(SHELL_TESTBENCH)"
+	$(SBT) "runMain bpaccel.shell.EmitShell --arch $(SHELL_ARCH) $(SHELL_CORE_ARGS) --stream-bits $(SHELL_STREAM_BITS) --dual-clock $(SHELL_DUAL_CLOCK) --target-dir $(SHELL_DIR)"
 	cd $(SHELL_DIR) && verilator --lint-only -Wall lint_waivers.vlt -F filelist.f --top-module BpaccelShell
-	$(PYTHON) test/bpaccel/shell/comb_paths.py $(SHELL_DIR) BpaccelShell BroadPhaseAccel
+	$(PYTHON) test/bpaccel/shell/comb_paths.py $(SHELL_DIR) BpaccelShell $(SHELL_CORE_TOP)
 	cd $(SHELL_DIR) && $(abspath $(SHELL_VENV))/peakrdl ip-xact bpaccel_shell.rdl -o bpaccel_shell_registers.xml
-	@echo "Shell for arch=$(SHELL_ARCH), m=$(SHELL_M), $(SHELL_STREAM_BITS)-bit streams: $(SHELL_DIR)/filelist.f"
+	@echo "Shell for arch=$(SHELL_ARCH)$(if $(filter binning,$(SHELL_ARCH)),$(if $(SHELL_BINNING), $(SHELL_BINNING)),, m=$(SHELL_M)), $(SHELL_STREAM_BITS)-bit streams: $(SHELL_DIR)/filelist.f"
 
 # docs/registers.md, from the default configuration's register map.
 shell-registers: deps

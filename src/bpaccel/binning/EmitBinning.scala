@@ -22,6 +22,15 @@ object EmitBinning {
       Array("--target", "systemverilog", "--split-verilog", "--target-dir", targetDir.toString),
       Seq(ChiselGeneratorAnnotation(() => new BinningCore(p))) ++ EmitVerilog.firtoolOptions.map(FirtoolOption(_))
     )
+    finishCore(p, targetDir)
+    Files.writeString(targetDir.resolve(EmitVerilog.lintWaivers), lintWaiverText)
+    targetDir.resolve("filelist.f")
+  }
+
+  /** What an emission of the core needs after firtool, alone or inside the stream shell: its memories
+    * rewritten for block and LUT RAM, its C header and JSON parameter file.
+    */
+  def finishCore(p: BinningParams, targetDir: Path): Unit = {
     SingleClockMemories.rewrite(targetDir)
     NoCollisionMemories.rewrite(targetDir)
     // The table's module must not be an entry or order memory's too (same rows and width), or those would go to LUT RAM.
@@ -31,8 +40,6 @@ object EmitBinning {
         "change groupCapacity or cellBits")
     DistributedMemories.rewrite(targetDir, Seq(table))
     emitParams(p, targetDir)
-    Files.writeString(targetDir.resolve(EmitVerilog.lintWaivers), lintWaiverText)
-    targetDir.resolve("filelist.f")
   }
 
   /** chisel3.util.Queue's memory reads combinationally: firtool's ram module has a read clock it never uses. */

@@ -22,7 +22,7 @@ import bpaccel.{Aabb, BroadPhaseAccel, RunRequest, ScheduleBeat}
   */
 class CellsAdapter(p: ShellParams) extends CoreAdapter(p, p.recordWords) {
   val opcode = Protocol.Cells
-  private val c = p.core
+  private val c = p.cells
 
   val cancelling = RegNext(io.cancel, false.B)
   // The core and its queues restart on a cancel: nothing of the command is left in them.
@@ -160,13 +160,14 @@ class CellsAdapter(p: ShellParams) extends CoreAdapter(p, p.recordWords) {
   io.summary.bits.issueCycles  := issue
   io.summary.bits.stallCycles  := stall
   io.summary.bits.pairs        := pairs
+  io.summary.bits.error        := 0.U.asTypeOf(new ItemError) // its checks come before the core: each is an itemError
   when(io.summary.fire) { phase := Phase.Idle }
   when(io.cancel) { phase := Phase.Finishing }
 }
 
 /** A result beat of the core with its cell's index in the command. */
 class CellResult(p: ShellParams) extends Bundle {
-  val beat = new ScheduleBeat(p.core)
+  val beat = new ScheduleBeat(p.cells)
   val cell = UInt(32.W)
 }
 

@@ -13,6 +13,8 @@ class CommandSummary extends Bundle {
   val issueCycles  = UInt(64.W)
   val stallCycles  = UInt(64.W)
   val pairs        = UInt(64.W)
+  /** An error the core found in the command's content (0: none), reported with its summary. */
+  val error        = new ItemError
 }
 
 /** Up to `words` words of reply records, the first `count` of them valid. */
@@ -37,13 +39,19 @@ class ItemError extends Bundle {
   * The control takes it (`take`) once the item is whole and not cut short
   * by TLAST, and handles padding, TLAST, draining and aborts itself. On
   * `cancel` (an error or an abort) the adapter stops its core and reports
-  * its summary at once; otherwise it reports it after its last record.
+  * its summary at once; otherwise it reports it after its last record, with
+  * the first error its core found in the body, if any (it names content
+  * that came before anything the control could find wrong afterwards). A
+  * cancel with `ended` (the packet ended before the body's last item) may
+  * instead end the core's command on the words that came whole, and report
+  * the summary, with the core's error, when the core does.
   */
 class AdapterIO(p: ShellParams, recordWords: Int) extends Bundle {
   val start     = Input(Bool())
   val window    = Input(new WordWindow(p))
   val take      = Input(Bool())
   val cancel    = Input(Bool())
+  val ended     = Input(Bool())
   val need      = Output(UInt(log2Ceil(p.itemWords + 1).W))
   val last      = Output(Bool())
   val ready     = Output(Bool())
@@ -62,7 +70,8 @@ abstract class CoreAdapter(val p: ShellParams, val recordWords: Int) extends Mod
 
 object CoreAdapter {
   /** The adapter of the configuration's core: the one place that knows which core answers which opcode. */
-  def apply(p: ShellParams): CoreAdapter = p.core.arch match {
-    case bpaccel.Arch.Seed | bpaccel.Arch.Stream => new CellsAdapter(p)
+  def apply(p: ShellParams): CoreAdapter = p.core match {
+    case ShellCoreParams.Cells(_)   => new CellsAdapter(p)
+    case ShellCoreParams.Binning(_) => new FrameAdapter(p)
   }
 }

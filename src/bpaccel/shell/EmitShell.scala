@@ -6,6 +6,7 @@ import chisel3.stage.ChiselGeneratorAnnotation
 import circt.stage.{ChiselStage, FirtoolOption}
 
 import bpaccel.{AccelParams, Arch, EmitVerilog, MemoryStyle, SingleClockMemories}
+import bpaccel.binning.{BinningParams, EmitBinning}
 
 /** Emits the shell of one configuration: its SystemVerilog (one file per
   * module, filelist.f), the core's bpaccel_params.h, the shell's
@@ -13,6 +14,8 @@ import bpaccel.{AccelParams, Arch, EmitVerilog, MemoryStyle, SingleClockMemories
   * and registers.md.
   *
   * Usage: EmitShell --arch stream --m 8 --capacity 64 --stream-bits 128 --target-dir build/shell
+  *        EmitShell --arch binning --group-bits 1,1,1 --lanes-per-group 2 --capacity 1024 --target-dir build/shell
+  * (the binning core also writes bpaccel_binning_params.h and bpaccel_params.json).
   */
 object EmitShell {
   val top = "BpaccelShell"
@@ -24,7 +27,10 @@ object EmitShell {
       Array("--target", "systemverilog", "--split-verilog", "--target-dir", targetDir.toString),
       Seq(ChiselGeneratorAnnotation(() => new BpaccelShell(p))) ++ firtoolOptions.map(FirtoolOption(_))
     )
-    EmitVerilog.finishCore(p.core, targetDir)
+    p.core match {
+      case ShellCoreParams.Cells(c)   => EmitVerilog.finishCore(c, targetDir)
+      case ShellCoreParams.Binning(b) => EmitBinning.finishCore(b, targetDir)
+    }
     val map = ShellRegisters(p)
     Files.writeString(targetDir.resolve("bpaccel_shell.h"), ShellHeader(p))
     Files.writeString(targetDir.resolve("bpaccel_shell.rdl"), RegisterMapEmitters.systemRdl(map))
@@ -57,30 +63,48 @@ object EmitShell {
     arch: String = Arch.Stream.name,
     m: Int = 8,
     capacity: Option[Int] = None,
-    keyWidth: Int = 32,
+    keyWidth: Option[Int] = None,
     batchCells: Int = AccelParams().batchCells,
     memoryStyle: String = MemoryStyle.Inferred.name,
+    binning: BinningParams = BinningParams(),
     streamBits: Int = ShellParams().streamBits,
     dualClock: Boolean = true,
     fifoDepth: Int = ShellParams().fifoDepth,
     targetDir: Path = Paths.get("build/shell"),
     smokeTestbench: Option[Path] = None
   ) {
-    def params: ShellParams = ShellParams(
-      AccelParams(m = m, capacity = capacity.getOrElse(Arch.fromName(arch).defaultCapacity(m)), keyWidth = keyWidth, arch = Arch.fromName(arch), batchCells = batchCells,
-        memoryStyle = MemoryStyle.fromName(memoryStyle)),
-      streamBits, dualClock, fifoDepth
-    )
+    def core: ShellCoreParams = {
+      val archs = Arch.all.map(_.name) :+ "binning"
+      require(archs.contains(arch), s"arch must be one of ${archs.mkString(", ")}, got arch = $arch")
+      if (arch == "binning")
+        binning.copy(boxCapacity = capacity.getOrElse(binning.boxCapacity), keyWidth = keyWidth.getOrElse(binning.keyWidth),
+          memoryStyle = MemoryStyle.fromName(memoryStyle))
+      else
+        AccelParams(m = m, capacity = capacity.getOrElse(Arch.fromName(arch).defaultCapacity(m)), keyWidth = keyWidth.getOrElse(32),
+          arch = Arch.fromName(arch), batchCells = batchCells, memoryStyle = MemoryStyle.fromName(memoryStyle))
+    }
+    def params: ShellParams = ShellParams(core, streamBits, dualClock, fifoDepth)
   }
 
   def main(args: Array[String]): Unit = {
     val parser = new scopt.OptionParser[Options]("EmitShell") {
       head("Emits the bpaccel AXI shell's SystemVerilog, C headers, SystemRDL and register page")
-      opt[String]("arch").action((v, o) => o.copy(arch = v)).text("core architecture: seed or stream (default stream)")
-      opt[Int]("m").action((v, o) => o.copy(m = v)).text("lanes")
-      opt[Int]("capacity").action((v, o) => o.copy(capacity = Some(v))).text("boxes per cell (default: the architecture's)")
-      opt[Int]("key-width").action((v, o) => o.copy(keyWidth = v)).text("bits per key (at most 32)")
-      opt[Int]("batch-cells").action((v, o) => o.copy(batchCells = v)).text("cell counts the core queues")
+      val b = BinningParams()
+      def binning(name: String, doc: String)(set: (BinningParams, Int) => BinningParams) =
+        opt[Int](name).action((v, o) => o.copy(binning = set(o.binning, v))).text(s"binning: $doc")
+      opt[String]("arch").action((v, o) => o.copy(arch = v)).text("core architecture: seed, stream or binning (default stream)")
+      opt[Int]("m").action((v, o) => o.copy(m = v)).text("seed, stream: lanes")
+      opt[Int]("capacity").action((v, o) => o.copy(capacity = Some(v)))
+        .text(s"boxes per cell (seed, stream; default: the architecture's) or per frame (binning; default ${b.boxCapacity})")
+      opt[Int]("key-width").action((v, o) => o.copy(keyWidth = Some(v))).text(s"bits per key (at most 32; default 32, binning ${b.keyWidth})")
+      opt[Int]("batch-cells").action((v, o) => o.copy(batchCells = v)).text("seed, stream: cell counts the core queues")
+      opt[String]("group-bits").action((v, o) => o.copy(binning = o.binning.copy(groupBits = v.split("[x,]").map(_.toInt).toSeq)))
+        .text(s"binning: ax,ay,az, 2^a lane groups per axis (default ${b.groupBits.mkString(",")})")
+      binning("lanes-per-group", s"lanes of each group (default ${b.g})")((q, v) => q.copy(lanesPerGroup = v))
+      binning("cell-bits", s"grid cells per axis at most 2^cell-bits (default ${b.cellBits})")((q, v) => q.copy(cellBits = v))
+      binning("group-capacity", s"entries of each group's memory (default ${b.groupCapacity})")((q, v) => q.copy(groupCapacity = v))
+      binning("intake-boxes", s"boxes the core takes a cycle (default ${b.intakeBoxes})")((q, v) => q.copy(intakeBoxes = v))
+      binning("pairs-per-beat", s"pairs the core sends a cycle (default ${b.pairsPerBeat})")((q, v) => q.copy(pairsPerBeat = v))
       opt[String]("memory-style").action((v, o) => o.copy(memoryStyle = v)).text("inferred or ecp5-outreg")
       opt[Int]("stream-bits").action((v, o) => o.copy(streamBits = v)).text("TDATA bits: 64, 128, 256 or 512")
       opt[Boolean]("dual-clock").action((v, o) => o.copy(dualClock = v)).text("the core on core_clk (default true)")

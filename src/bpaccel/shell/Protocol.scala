@@ -41,7 +41,7 @@ object Protocol {
   case class ErrorCode(name: String, code: Int, doc: String)
   private val coreDocs = Map(
     "NONE" -> "the command succeeded",
-    "COUNT_OVER_CAPACITY" -> "a cell's count is above the capacity (detail: the cell)",
+    "COUNT_OVER_CAPACITY" -> "a cell's count (FRAME: n) is above the capacity (detail: the cell; FRAME: 0)",
     "COUNT_OVER_LOADED" -> "core only: a start with fewer boxes loaded",
     "LOAD_OVERFLOW" -> "core only: a box beyond the capacity",
     "SPLIT_OUT_OF_RANGE" -> "a cell's split is not 0 and not below its count (detail: the cell)",
@@ -50,14 +50,22 @@ object Protocol {
   val coreErrors: Seq[ErrorCode] =
     AccelError.names.map { case (name, e) => ErrorCode(name, AccelError.code(e), coreDocs(name)) }
   val BadCommand     = ErrorCode("BAD_COMMAND", 16, "unknown opcode, wrong version, or nonzero bits [31:16] in the header: the packet is drained, the reply is the trailer")
-  val LengthMismatch = ErrorCode("LENGTH_MISMATCH", 17, "TLAST before the command's last item, or not on the beat that holds it, or nonzero padding (detail: the cell being read, or the cell count when data follows the last cell)")
+  val LengthMismatch = ErrorCode("LENGTH_MISMATCH", 17, "TLAST before the command's last item, or not on the beat that holds it, or nonzero padding (detail: CELLS: the cell being read, or the cell count when data follows the last cell; FRAME: the boxes the packet carried whole up to its TLAST, or n when data follows the n-th box)")
   val KeyTooWide     = ErrorCode("KEY_TOO_WIDE", 18, "a key has bits set above the device's key width (detail: the box, counted over the command from 0)")
   val Aborted        = ErrorCode("ABORTED", 19, "CONTROL.ABORT ended the command; the rest of its packet is drained")
   val KeyOutOfGrid   = ErrorCode("KEY_OUT_OF_GRID", 20, "FRAME: a key's cell is outside the grid (detail: the box)")
   val BoxSpansCells  = ErrorCode("BOX_SPANS_CELLS", 21, "FRAME: a box spans more than two cells on an axis (detail: the box)")
   val GroupOverflow  = ErrorCode("GROUP_OVERFLOW", 22, "FRAME: a lane group's memory is full (detail: the box)")
-  val shellErrors: Seq[ErrorCode] = Seq(BadCommand, LengthMismatch, KeyTooWide, Aborted, KeyOutOfGrid, BoxSpansCells, GroupOverflow)
+  val BadGrid        = ErrorCode("BAD_GRID", 23, "FRAME: the shift is above the device's MAX_SHIFT, a dimension is 0 or above 2^CELL_BITS, or a reserved header bit is set (detail: 0)")
+  val BoxInverted    = ErrorCode("BOX_INVERTED", 24, "FRAME: a box's min key is above its max key on an axis (detail: the box)")
+  val shellErrors: Seq[ErrorCode] =
+    Seq(BadCommand, LengthMismatch, KeyTooWide, Aborted, KeyOutOfGrid, BoxSpansCells, GroupOverflow, BadGrid, BoxInverted)
   val errors: Seq[ErrorCode] = coreErrors ++ shellErrors
   require(errors.map(_.code).distinct.length == errors.length, "error codes must be distinct")
   require(errors.forall(_.code < 256), "error codes fit the trailer's 8 bits")
+
+  /** The protocol's code of each of the binning core's error codes (bpaccel.binning.BinningErrorCode), matched by name. */
+  val frameErrors: Seq[(Int, ErrorCode)] = bpaccel.binning.BinningErrorCode.names.map { case (name, core) =>
+    core -> errors.find(_.name == name).getOrElse(sys.error(s"the protocol has no code for the binning core's $name"))
+  }
 }

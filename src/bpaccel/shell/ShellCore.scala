@@ -54,8 +54,10 @@ class ShellCore(p: ShellParams) extends Module {
   val start  = WireDefault(false.B)
   val take   = WireDefault(false.B)
   val cancel = WireDefault(false.B)
+  val ended  = WireDefault(false.B)
   adapter.io.start := start
   adapter.io.take  := take
+  adapter.io.ended := ended
 
   // The header: [7:0] opcode, [15:8] version, [31:16] zero.
   private val header = window.words(0)
@@ -99,6 +101,7 @@ class ShellCore(p: ShellParams) extends Module {
       consume := endsAt + 1.U
       fail(Protocol.LengthMismatch.code.U, adapter.io.position)
       cancel := true.B
+      ended  := true.B
       state  := State.Done
     }.elsewhen(whole && adapter.io.itemError.valid) {
       consume := need
@@ -142,6 +145,9 @@ class ShellCore(p: ShellParams) extends Module {
     summary   := adapter.io.summary.bits
     summaryIn := true.B
     running   := false.B
+    // The core's error names content before anything found after it (a summary after a cancel carries none).
+    val coreError = adapter.io.summary.bits.error
+    when(coreError.code =/= 0.U) { error := coreError.code; detail := coreError.detail }
   }
 
   // The trailer (docs/protocol.md).

@@ -42,8 +42,22 @@ object ShellRegisters {
   private def capability(name: String, offset: Int, value: BigInt, doc: String, width: Int = 32): Register =
     Register(name, offset, doc, Seq(Field("VALUE", 0, width, ReadOnly, doc, constant = Some(value))))
 
+  /** What the capability registers say of a core. */
+  private case class CoreFacts(
+    lanes: Int, capacity: Int, batchCells: Int, bipartite: Boolean, overlapsLoads: Boolean, runOverhead: Int,
+    readLatency: Int, laneGroups: Int, lanesPerGroup: Int, cellBits: Int, intakeBoxes: Int
+  )
+  private def facts(core: ShellCoreParams): CoreFacts = core match {
+    case ShellCoreParams.Cells(c) =>
+      CoreFacts(c.m, c.capacity, c.batchCells, c.bipartiteRuns, c.overlapsLoads, c.runOverheadCycles,
+        if (c.arch == Arch.Stream) c.readLatency else 0, laneGroups = 1, lanesPerGroup = c.m, cellBits = 0, intakeBoxes = 1)
+    case ShellCoreParams.Binning(b) =>
+      CoreFacts(b.lanes, b.boxCapacity, batchCells = 0, bipartite = false, overlapsLoads = false, runOverhead = 0,
+        readLatency = 0, laneGroups = b.groups, lanesPerGroup = b.g, cellBits = b.cellBits, intakeBoxes = b.intakeBoxes)
+  }
+
   def apply(p: ShellParams): RegisterMap = {
-    val c = p.core
+    val c = facts(p.core)
     def flag(b: Boolean): BigInt = if (b) 1 else 0
     val identity = Seq(
       capability("ID", 0x000, Id, "\"BPAC\": a bpaccel shell answers here"),
@@ -54,31 +68,31 @@ object ShellRegisters {
       capability("FINGERPRINT", 0x008, fingerprint(p), "CRC-32 of the configuration string (BPACCEL_SHELL_FINGERPRINT_TEXT)")
     )
     val capabilities = Seq(
-      capability("ARCH", 0x010, c.arch.id, s"architecture: ${Arch.all.map(a => s"${a.id} ${a.name}").mkString(", ")}, 2 binning"),
+      capability("ARCH", 0x010, p.core.archId, s"architecture: ${Arch.all.map(a => s"${a.id} ${a.name}").mkString(", ")}, 2 binning"),
       capability("OPCODES", 0x014, p.opcodes.map(o => BigInt(1) << o.code).sum, "bit n set: the device answers opcode n"),
-      capability("LANES", 0x018, c.m, "m: pair tests per cycle"),
+      capability("LANES", 0x018, c.lanes, "m: pair tests per cycle"),
       capability("CAPACITY", 0x01c, c.capacity, "most boxes in one cell (CELLS) or frame (FRAME)"),
-      capability("KEY_WIDTH", 0x020, c.keyWidth, "bits of a key; higher bits of a key's slot must be 0"),
-      capability("INDEX_WIDTH", 0x024, c.indexWidth, "bits of a box index in a record"),
+      capability("KEY_WIDTH", 0x020, p.core.keyWidth, "bits of a key; higher bits of a key's slot must be 0"),
+      capability("INDEX_WIDTH", 0x024, p.core.indexWidth, "bits of a box index in a record"),
       capability("STREAM_BITS", 0x028, p.streamBits, "TDATA bits of both streams"),
       capability("BATCH_CELLS", 0x02c, c.batchCells, "cell counts the core queues ahead (CELLS)"),
       Register("FEATURES", 0x030, "what the device can do", Seq(
-        Field("BIPARTITE", 0, 1, ReadOnly, "cells may carry a split (bipartite runs)", constant = Some(flag(c.bipartiteRuns))),
+        Field("BIPARTITE", 0, 1, ReadOnly, "cells may carry a split (bipartite runs)", constant = Some(flag(c.bipartite))),
         Field("OVERLAPS_LOADS", 1, 1, ReadOnly, "a cell loads while the one before runs", constant = Some(flag(c.overlapsLoads))),
         Field("DUAL_CLOCK", 2, 1, ReadOnly, "the core runs on core_clk", constant = Some(flag(p.dualClock)))
       )),
-      capability("RUN_OVERHEAD_CYCLES", 0x034, c.runOverheadCycles, "cycles of a run beyond issues and stalls, after its startup"),
-      capability("READ_LATENCY", 0x038, if (c.arch == Arch.Stream) c.readLatency else 0, "a run's startup cycles (stream; 0 for the seed)"),
+      capability("RUN_OVERHEAD_CYCLES", 0x034, c.runOverhead, "cycles of a run beyond issues and stalls, after its startup"),
+      capability("READ_LATENCY", 0x038, c.readLatency, "a run's startup cycles (stream; 0 for the seed and binning)"),
       Register("FORMAT", 0x03c, "words of the stream's items", Seq(
         Field("BOX_WORDS", 0, 8, ReadOnly, "words of one box: 3 (keys of 16 bits or fewer) or 6", constant = Some(p.boxWords)),
-        Field("RECORD_WORDS", 8, 8, ReadOnly, "words of one CELLS record", constant = Some(p.recordWords)),
+        Field("RECORD_WORDS", 8, 8, ReadOnly, "words of one record: CELLS indices, cell and mask; FRAME a pair's indices", constant = Some(p.recordWords)),
         Field("TRAILER_WORDS", 16, 8, ReadOnly, "words of the trailer", constant = Some(Protocol.TrailerWords)),
         Field("INDEX_WORDS", 24, 8, ReadOnly, "words of a record's indices: 1 ({j, i}) or 2 (i, j)", constant = Some(p.indexWords))
       )),
-      capability("LANE_GROUPS", 0x040, 1, "lane groups (binning; 1 for the CELLS devices)"),
-      capability("LANES_PER_GROUP", 0x044, c.m, "lanes of each group"),
-      capability("CELL_BITS", 0x048, 0, "binning: cells per axis at most 2^CELL_BITS (0: no binning)"),
-      capability("INTAKE_BOXES", 0x04c, 1, "boxes the core takes a cycle at most")
+      capability("LANE_GROUPS", 0x040, c.laneGroups, "lane groups (binning; 1 for the CELLS devices)"),
+      capability("LANES_PER_GROUP", 0x044, c.lanesPerGroup, "lanes of each group"),
+      capability("CELL_BITS", 0x048, c.cellBits, "binning: cells per axis at most 2^CELL_BITS (0: no binning)"),
+      capability("INTAKE_BOXES", 0x04c, c.intakeBoxes, "boxes the core takes a cycle at most")
     )
     val control = Seq(
       Register("CONTROL", ControlOffset, "actions; each bit starts its action once and reads 0", Seq(
