@@ -274,3 +274,11 @@ TEST(ShellDriverFrame, EncodesSendsAndDecodesAFrameThroughTheSameSequence) {
   driver.runFrame(boxes, {.shift = 4, .cells = {1, 1, 1}}, 8, out);
   EXPECT_EQ(out, (std::vector<Pair>{{0, 1}}));
 }
+
+TEST(ShellReply, NamesEveryErrorCodeTheGeneratedHeaderDefines) {
+  // The FRAME device's codes too; an unknown code is named by its number.
+  EXPECT_EQ(shellErrorName(BPACCEL_SHELL_ERR_GROUP_OVERFLOW), "GROUP_OVERFLOW");
+  EXPECT_EQ(shellErrorName(BPACCEL_SHELL_ERR_BAD_GRID), "BAD_GRID");
+  EXPECT_EQ(shellErrorName(BPACCEL_SHELL_ERR_BOX_INVERTED), "BOX_INVERTED");
+  EXPECT_EQ(shellErrorName(250), "error 250");
+}
