@@ -44,3 +44,30 @@ object DistributedMemories {
     }
   }
 }
+
+/** Asks synthesis to build the smallest queue memories from flip-flops
+  * rather than LUT RAM, in the same three tools' words (Yosys honours each).
+  * chisel3.util.Queue's memory is a `Mem`, which firtool emits as
+  * `ram_<depth>x<width>`. On the ECP5 a TRELLIS_DPR16X4 (16 rows x 4 bits)
+  * takes 6 LUT4 positions however few rows are used, so W bits of LUT RAM
+  * cost 1.5 W LUT4 at any depth up to 16; as registers, 2 rows cost W LUT4
+  * (a 2:1 read mux a bit) and 2 W flip-flops, 4 rows already 2 W LUT4 (a 4:1
+  * mux a bit). Registers therefore win up to depth 2 only.
+  */
+object RegisterMemories {
+  val attribute = """(* ram_style = "registers", ramstyle = "logic", syn_ramstyle = "registers" *)"""
+  val maxDepth  = 2
+
+  private val QueueMemory = """ram_(\d+)x(\d+)\.sv""".r
+
+  /** Marks every queue memory `ram_<depth>x<width>` of at most `maxDepth` rows in `dir`; returns their module names. */
+  def rewrite(dir: Path): Seq[String] =
+    SingleClockMemories.listedFiles(dir).flatMap { file =>
+      file.getFileName.toString match {
+        case QueueMemory(depth, _) if depth.toInt <= maxDepth =>
+          MemoryAttributes.mark(file, attribute, "RegisterMemories")
+          Some(file.getFileName.toString.stripSuffix(".sv"))
+        case _ => None
+      }
+    }
+}

@@ -5,7 +5,7 @@ import java.nio.file.{Files, Path, Paths}
 import chisel3.stage.ChiselGeneratorAnnotation
 import circt.stage.{ChiselStage, FirtoolOption}
 
-import bpaccel.{DistributedMemories, EmitVerilog, MemoryStyle, NoCollisionMemories, SingleClockMemories}
+import bpaccel.{DistributedMemories, EmitVerilog, MemoryStyle, NoCollisionMemories, RegisterMemories, SingleClockMemories}
 
 /** Emits one binning configuration: SystemVerilog (one file per module and
   * filelist.f), its C header and its JSON parameter file.
@@ -39,6 +39,8 @@ object EmitBinning {
       throw new IllegalArgumentException(s"EmitBinning: the cell table's memory module $table is also a group memory's; " +
         "change groupCapacity or cellBits")
     DistributedMemories.rewrite(targetDir, Seq(table))
+    // The two-entry queues (128 lane queues at the defaults) cost fewer LUT4 positions as flip-flops than as LUT RAM.
+    RegisterMemories.rewrite(targetDir)
     emitParams(p, targetDir)
   }
 

@@ -8,11 +8,11 @@ import scala.sys.process._
 import org.scalatest.flatspec.AnyFlatSpec
 import org.scalatest.matchers.should.Matchers
 
-import bpaccel.{DistributedMemories, EmitVerilog, NoCollisionMemories, SingleClockMemories}
+import bpaccel.{DistributedMemories, EmitVerilog, NoCollisionMemories, RegisterMemories, SingleClockMemories}
 
 /** What FPGA flows and hosts get from EmitBinning: lint-clean SystemVerilog,
-  * memories that synthesis maps to block RAM, and a C header and JSON file
-  * that say the same as the parameters.
+  * memories that synthesis maps to block RAM, LUT RAM or flip-flops as
+  * meant, and a C header and JSON file that say the same as the parameters.
   */
 class BinningEmissionSpec extends AnyFlatSpec with Matchers {
   private lazy val default = emitted(BinningParams())
@@ -27,6 +27,12 @@ class BinningEmissionSpec extends AnyFlatSpec with Matchers {
     val log = new StringBuilder
     val exit = Process(cmd, dir.toFile).!(ProcessLogger(l => log.append(l).append('\n'), l => log.append(l).append('\n')))
     (exit, log.toString)
+  }
+  /** The cells Yosys 0.23's synth_ecp5 makes of `module` in `file`. */
+  private def ecp5Cells(dir: Path, module: String, file: String): Map[String, Int] = {
+    val (exit, log) = run(dir, Seq("yosys", "-q", "-p", s"read_verilog -sv $file; synth_ecp5 -top $module; tee -o $file.stat stat"))
+    withClue(log.takeRight(3000)) { exit shouldBe 0 }
+    "(?m)^\\s+(\\w+)\\s+(\\d+)$".r.findAllMatchIn(read(dir, s"$file.stat")).map(x => x.group(1) -> x.group(2).toInt).toMap
   }
 
   behavior of "EmitBinning"
@@ -53,13 +59,20 @@ class BinningEmissionSpec extends AnyFlatSpec with Matchers {
     "(?m)^\\s*LaneGroup\\s+\\w+\\s*\\(".r.findAllIn(read(dir, "BinningCore.sv")).length shouldBe p.groups
   }
 
+  it should "ask for flip-flops for the two-entry queue memories (the lane queues among them) and for no deeper one" in {
+    val (p, dir) = default
+    val queueMemories = SingleClockMemories.listedFiles(dir).map(_.getFileName.toString).filter(_.startsWith("ram_"))
+    val twoEntry = queueMemories.filter(_.startsWith("ram_2x"))
+    twoEntry should contain(s"ram_${p.laneQueueDepth}x${p.entryBits}.sv")
+    (queueMemories.toSet -- twoEntry) should not be empty // deeper queues exist and stay LUT RAM
+    for (m <- queueMemories) withClue(s"$m: ") {
+      read(dir, m).contains(RegisterMemories.attribute) shouldBe twoEntry.contains(m)
+    }
+  }
+
   it should "map the entry and order memories alone to ECP5 block RAM (DP16KD) and the cell table to LUT RAM" in {
     val (p, dir) = default
-    def cells(module: String, file: String): Map[String, Int] = {
-      val (exit, log) = run(dir, Seq("yosys", "-q", "-p", s"read_verilog -sv $file; synth_ecp5 -top $module; tee -o $file.stat stat"))
-      withClue(log.takeRight(3000)) { exit shouldBe 0 }
-      "(?m)^\\s+(\\w+)\\s+(\\d+)$".r.findAllMatchIn(read(dir, s"$file.stat")).map(x => x.group(1) -> x.group(2).toInt).toMap
-    }
+    def cells(module: String, file: String): Map[String, Int] = ecp5Cells(dir, module, file)
     def memory(module: String): Map[String, Int] = cells(module, s"$module.sv")
     val entries = memory(s"mem_${p.groupCapacity}x${p.entryBits}")
     entries.getOrElse("DP16KD", 0) shouldBe 4 // 1024 x 71: four 1024 x 18 blocks
@@ -72,6 +85,24 @@ class BinningEmissionSpec extends AnyFlatSpec with Matchers {
     // The attribute does it: without it, Yosys puts the table into a DP16KD of its own.
     Files.writeString(dir.resolve("bare-table.sv"), read(dir, s"$tableModule.sv").replace(s"${DistributedMemories.attribute} ", ""))
     cells(tableModule, "bare-table.sv").getOrElse("DP16KD", 0) shouldBe 1
+  }
+
+  it should "map a lane queue's two-entry memory to flip-flops and a deeper queue's to LUT RAM" in {
+    val (p, dir) = default
+    def cells(module: String, file: String): Map[String, Int] = ecp5Cells(dir, module, file)
+    val lane = s"ram_${p.laneQueueDepth}x${p.entryBits}"
+    p.laneQueueDepth shouldBe 2
+    val registers = cells(lane, s"$lane.sv")
+    registers.keys.filter(_.startsWith("TRELLIS_DPR")) shouldBe empty
+    registers.getOrElse("TRELLIS_FF", 0) shouldBe 2 * p.entryBits
+    registers.getOrElse("LUT4", 0) should be <= p.entryBits + 4 // one 2:1 read mux a bit, a few write enables
+    // The attribute does it: without it, Yosys builds the same memory from 18 blocks of 16 x 4 LUT RAM.
+    Files.writeString(dir.resolve("bare-lane.sv"), read(dir, s"$lane.sv").replace(s"${RegisterMemories.attribute} ", ""))
+    cells(lane, "bare-lane.sv").getOrElse("TRELLIS_DPR16X4", 0) shouldBe (p.entryBits + 3) / 4
+    val hitQueue = s"ram_${p.hitQueueDepth}x"
+    val deeper = SingleClockMemories.listedFiles(dir).map(_.getFileName.toString.stripSuffix(".sv")).filter(_.startsWith(hitQueue))
+    deeper should not be empty
+    for (m <- deeper) withClue(s"$m: ") { cells(m, s"$m.sv").getOrElse("TRELLIS_DPR16X4", 0) should be > 0 }
   }
 
   it should "write a C header and a JSON file with the parameters and every error code" in {
