@@ -33,9 +33,9 @@ ShellFormat binningShellFormat(const BinningParams& params) {
   ShellFormat f;
   f.wordsPerBeat = 8;
   f.keyWidth = params.keyWidth;
-  f.boxWords = params.keyWidth <= 16 ? 3 : 6;
+  f.boxWords = static_cast<unsigned>(frameBoxBytes(params.keyWidth) / 4);  // the link model's sizes, in words
   f.indexWidth = params.indexWidth();
-  f.indexWords = params.indexWidth() <= 16 ? 1 : 2;
+  f.indexWords = static_cast<unsigned>(framePairBytes(params.indexWidth()) / 4);
   f.lanes = params.lanes();
   f.capacity = params.boxCapacity;
   f.bipartite = false;
@@ -108,9 +108,7 @@ DeviceProfile binningProfile(const DeviceProfile& profile, const BinningParams& 
   standIn.source = "stand-in: the stream device's clock, " + standIn.source;
   DeviceProfile p = profile;
   if (profile.name == "ecp5-5g") {
-    std::string report = findFiveGReport(in);
-    if (report.empty()) report = in.lfe5uReport + " with -lfe5um5g-85f (none found)";
-    p.part = resolvePart(profile.part.name, profile.part.speedGrade, std::move(report), in.device, standIn);
+    p.part = resolvePart(profile.part.name, profile.part.speedGrade, fiveGReportOrPattern(in), in.device, standIn);
     return p;
   }
   const DeviceClock c = clockFromFpgaReport(in.lfe5uReport, in.device.m, in.device.arch, in.device.keyWidth);

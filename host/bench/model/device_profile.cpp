@@ -106,7 +106,8 @@ PartProfile resolvePart(std::string name, int speedGrade, std::string report, co
   p.speedGrade = speedGrade;
   p.report = std::move(report);
   p.reportPresent = !p.report.empty() && std::filesystem::is_regular_file(p.report);
-  std::string why = p.report.empty() ? fmt::format("no {} report", p.name) : fmt::format("no {} report: {}", p.name, p.report);
+  std::string why = fmt::format("no {} report", p.name);
+  if (!p.report.empty()) why += ": " + p.report;
   if (p.reportPresent) {
     const DeviceClock c = clockFromFpgaReport(p.report, device.m, device.arch, device.keyWidth);
     if (c.measured) {
@@ -136,15 +137,21 @@ std::string findFiveGReport(const ProfileInputs& in) {
   return found.empty() ? std::string() : found.front();
 }
 
+std::string fiveGReportOrPattern(const ProfileInputs& in) {
+  std::string report = findFiveGReport(in);
+  if (report.empty())
+    report = fmt::format("{}/{}-*um5g*.json (none found)", in.fpgaDir,
+                         std::filesystem::path(fpgaReportPath(in.device.m, in.device.arch, in.device.keyWidth))
+                             .stem()
+                             .string());
+  return report;
+}
+
 DeviceProfile ecp5FiveGProfile(const ProfileInputs& in) {
   DeviceProfile p;
   p.name = "ecp5-5g";
   p.description = "an ECP5-5G card: the LFE5UM5G-85F speed 8 with its PCIe Gen2 x1 endpoint";
-  std::string report = findFiveGReport(in);
-  if (report.empty()) report = fmt::format("{}/{}-*um5g*.json (none found)", in.fpgaDir,
-                                          std::filesystem::path(fpgaReportPath(in.device.m, in.device.arch,
-                                                                               in.device.keyWidth)).stem().string());
-  p.part = resolvePart("LFE5UM5G-85F", 8, std::move(report), in.device, lfe5uStandIn(in));
+  p.part = resolvePart("LFE5UM5G-85F", 8, fiveGReportOrPattern(in), in.device, lfe5uStandIn(in));
   // Lattice's PCI Express Endpoint IP Core user guide for ECP5 and ECP5-5G
   // (FPGA-IPUG-02009) offers x1 and x2 endpoints, Gen2 (5 GT/s) on the -5G
   // parts; a documentation search here did not return that guide, so x1 is

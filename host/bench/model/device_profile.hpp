@@ -104,5 +104,7 @@ DeviceProfile builtInProfile(const std::string& name, const ProfileInputs& in);
 /// named as the LFE5U-85F's (results/fpga/<design>.json) with "um5g" in the
 /// rest of its name; empty where there is none.
 std::string findFiveGReport(const ProfileInputs& in);
+/// That report, or where it was looked for ("<fpgaDir>/<design>-*um5g*.json (none found)").
+std::string fiveGReportOrPattern(const ProfileInputs& in);
 
 }  // namespace bpaccel
