@@ -15,7 +15,7 @@ std::size_t framePairBytes(unsigned indexWidth) { return indexWidth <= 16 ? 4 : 
 BinningFrameModel modelBinningFrame(const BinningFrameStats& stats, const BinningParams& params,
                                     const DeviceProfile& profile) {
   const double clock = profile.part.clockHz.value, bandwidth = profile.link.effectiveBytesPerSecond.value;
-  const double frames = static_cast<double>(stats.slabs + stats.retries);
+  const double frames = static_cast<double>(stats.frames + stats.retries);
   const double boxBytes = static_cast<double>(stats.boxesSent * frameBoxBytes(params.keyWidth)) +
                           frames * kFrameHeaderBytes;
   const double backBytes = static_cast<double>(stats.devicePairs * framePairBytes(params.indexWidth())) +
@@ -88,7 +88,7 @@ FrameTime BinningMethod::frameTime(double measuredSeconds) const {
   p.hostSeconds = measuredSeconds - simulationSeconds_;
   p.deviceSeconds = m.deviceSeconds;
   p.transferSeconds = m.transferSeconds;
-  p.stats.runs = p.stats.batches = s.slabs + s.retries;
+  p.stats.runs = p.stats.batches = s.frames + s.retries;
   p.stats.cycles = s.deviceCycles;
   p.stats.issueCycles = s.issueCycles;
   p.stats.hits = s.devicePairs;

@@ -95,7 +95,7 @@ int main(int argc, char** argv) {
              "(issue 41: <= 40 %)\n", bpaccel::median(cycles), 100 * bpaccel::median(cycles) / kStreamCycles, kStreamCycles);
   fmt::print("last frame: {} device frames ({} refused for room), {} boxes sent, {} on the host's path, grid {}x{}x{}, "
              "phases intake {} prefix {} sort {} compute {} drain {}, {} device pairs ({} false from quantization)\n",
-             s.slabs + s.retries, s.retries, s.boxesSent, s.hostBoxes, dims[0], dims[1], dims[2], phases.intake, phases.prefix, phases.sort,
+             s.frames + s.retries, s.retries, s.boxesSent, s.hostBoxes, dims[0], dims[1], dims[2], phases.intake, phases.prefix, phases.sort,
              phases.compute, phases.drain, s.devicePairs, s.falsePositives);
   for (std::size_t k = 0; k < methods.size(); ++k) {
     const double host = bpaccel::median(rows[k].host), dev = bpaccel::median(rows[k].device),

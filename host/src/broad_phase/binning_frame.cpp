@@ -201,7 +201,7 @@ void BinningFrame::send() {
     if (r.error != FrameError::None)
       throw std::logic_error(fmt::format("binning frame: the device refused a frame of the host's with {} at box {}",
                                          frameErrorName(r.error), r.detail));
-    stats_.slabs += 1;
+    stats_.frames += 1;
     stats_.devicePairs += r.pairs.size();
     stats_.issueCycles += r.issueCycles;
     stats_.phases.intake += r.phases.intake, stats_.phases.prefix += r.phases.prefix;

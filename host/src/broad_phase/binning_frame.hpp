@@ -16,7 +16,7 @@ namespace bpaccel {
 
 /// What the last frame cost, counted as the device and the link would see it.
 struct BinningFrameStats {
-  std::size_t slabs = 0;           // device frames that returned pairs (one a region)
+  std::size_t frames = 0;          // device frames that returned pairs (a region each)
   std::size_t retries = 0;         // frames the device refused for room (then cut in two)
   std::size_t boxesSent = 0;       // boxes over the link, summed over the frames sent
   std::size_t hostBoxes = 0;       // boxes too long for the grid, tested on the host
@@ -72,7 +72,7 @@ class BinningFrame {
   /// Appends the pairs (i < j) to `out` (cleared first). Throws InputError for a NaN or inverted box.
   void findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out);
   /// The steps of findPairs, for a caller that times them: plan (checks,
-  /// grid, keys, slabs), send (the frames to the device, and their replies
+  /// grid, keys, regions), send (the frames to the device, and their replies
   /// kept), collect (decode, recheck, the host's exact path). plan's boxes
   /// are read until collect returns: they must stay alive and unchanged.
   void plan(std::span<const Aabb> boxes);

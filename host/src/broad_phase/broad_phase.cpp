@@ -117,7 +117,7 @@ void BroadPhase::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) 
     binning_->findPairs(boxes, out);
     const BinningFrameStats& b = binning_->stats();
     stats_ = {};
-    stats_.runs = stats_.batches = b.slabs + b.retries;
+    stats_.runs = stats_.batches = b.frames + b.retries;
     stats_.cycles = b.deviceCycles;
     stats_.issueCycles = b.issueCycles;
     stats_.hits = b.devicePairs;

@@ -1,5 +1,5 @@
 // The host's frame path to the binning device (on its C++ model): exact
-// against brute force on float scenes, slabs with their boundary pairs, the
+// against brute force on float scenes, regions with their boundary pairs, the
 // host's path for long boxes, bad input.
 
 #include <gtest/gtest.h>
@@ -18,7 +18,7 @@ namespace {
 using testing::bruteForce;
 using testing::sorted;
 
-/// A small device, so that scenes of a few hundred boxes need slabs.
+/// A small device, so that scenes of a few hundred boxes need several regions.
 BinningParams smallDevice() {
   BinningParams p;
   p.groupBits = {1, 1, 1}, p.lanesPerGroup = 2, p.keyWidth = 9, p.cellBits = 3;
@@ -54,7 +54,7 @@ TEST(BinningFrame, CutsScenesAboveTheCapacityIntoRegionsOnTwoAxesAndKeepsEachBou
     frame.findPairs(boxes, out);
     EXPECT_EQ(sorted(out), bruteForce(boxes)) << "seed " << seed;
     const BinningFrameStats& stats = frame.stats();
-    EXPECT_GE(stats.slabs, 4u);
+    EXPECT_GE(stats.frames, 4u);
     EXPECT_GT(stats.boundaryDrops, 0u) << "no pair was found by two regions: the boundary rule went untested";
     EXPECT_GT(stats.boxesSent, boxes.size()) << "no box straddled a region boundary";
     // A grid of regions over two axes (and cut again on refusal): no region is a slab across the whole scene.
@@ -81,7 +81,7 @@ TEST(BinningFrame, RetriesInSlabsWhenAGroupOverflowsAndTestsUncuttableSlabsOnThe
   EXPECT_GT(stats.retries, 0u);
   const std::vector<Aabb> stacked(100, testing::box(7, 7, 7, 7, 7, 7));  // no cut separates them
   EXPECT_EQ(framePairs(small, stacked, &stats), bruteForce(stacked));
-  EXPECT_EQ(stats.slabs, 0u);
+  EXPECT_EQ(stats.frames, 0u);
 }
 
 TEST(BinningFrame, RechecksQuantizedPairsAndDropsTheFalseOnes) {

@@ -28,7 +28,7 @@ DeviceProfile testProfile() {
 TEST(BinningMethod, ChargesTheDeviceItsCyclesAndTheLinkEachBoxOnceBeyondTheIntake) {
   BinningParams params;  // kw = 12: a box is 3 words; 13-bit indices: a pair is a word
   BinningFrameStats s;
-  s.slabs = 2;
+  s.frames = 2;
   s.boxesSent = 10000;
   s.devicePairs = 5000;
   s.deviceCycles = 9000;
