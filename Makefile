@@ -80,6 +80,7 @@ test: deps
 test-hw: deps
 	$(SBT) test $(if $(call stale,$(HOST_VERILOG)/filelist.f),$(EMIT_HOST)) \
 	  $(if $(call stale,$(BINNING_PARAMS_DIR)/bpaccel_binning_params.h),$(EMIT_BINNING_PARAMS)) \
+	  $(if $(call stale,$(HOST_FRAME_SHELL)/filelist.f),$(EMIT_HOST_FRAME_SHELL)) \
 	  $(if $(call stale,$(FPGA_TEST_VERILOG)/filelist.f $(FPGA_TEST_STREAM_VERILOG)/filelist.f),$(EMIT_FPGA_TEST))
 
 # The formal checks at depths that cover a whole run of each small
@@ -98,9 +99,21 @@ EMIT_BINNING_PARAMS = "runMain bpaccel.binning.EmitBinning --params-only --targe
 $(BINNING_PARAMS_DIR)/bpaccel_binning_params.h: $(SCALA_SOURCES) $(wildcard src/bpaccel/binning/*.scala) | deps
 	$(SBT) $(EMIT_BINNING_PARAMS)
 
-host: deps $(HOST_VERILOG)/filelist.f $(BINNING_PARAMS_DIR)/bpaccel_binning_params.h
-	cmake -S host -B $(HOST_BUILD) -G Ninja -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BIN_DIR=$(abspath $(HOST_BIN_DIR)) \
-	  -DBPACCEL_BINNING_DIR=$(abspath $(BINNING_PARAMS_DIR))
+# A small binning shell, verilated for the tests of the driver's FRAME path
+# against the hardware (host/src/device/rtl/frame): 8 lane groups of 2
+# lanes, 512 boxes a frame, 128-bit streams, two clocks.
+HOST_FRAME_SHELL := build/host-shell/binning-g8-c512-w128
+HOST_FRAME_SHELL_ARGS := --group-bits 1,1,1 --lanes-per-group 2 --cell-bits 4 --capacity 512 --group-capacity 256 \
+  --intake-boxes 4 --pairs-per-beat 4 --stream-bits 128 --dual-clock true
+EMIT_HOST_FRAME_SHELL = "runMain bpaccel.shell.EmitShell --arch binning $(HOST_FRAME_SHELL_ARGS) --target-dir $(HOST_FRAME_SHELL)"
+$(HOST_FRAME_SHELL)/filelist.f: $(SCALA_SOURCES) $(wildcard src/bpaccel/shell/*.scala src/bpaccel/binning/*.scala) | deps
+	$(SBT) $(EMIT_HOST_FRAME_SHELL)
+HOST_GENERATED := $(HOST_VERILOG)/filelist.f $(BINNING_PARAMS_DIR)/bpaccel_binning_params.h $(HOST_FRAME_SHELL)/filelist.f
+HOST_GENERATED_DIRS := -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BINNING_DIR=$(abspath $(BINNING_PARAMS_DIR)) \
+  -DBPACCEL_FRAME_SHELL_DIR=$(abspath $(HOST_FRAME_SHELL))
+
+host: deps $(HOST_GENERATED)
+	cmake -S host -B $(HOST_BUILD) -G Ninja $(HOST_GENERATED_DIRS) -DBPACCEL_BIN_DIR=$(abspath $(HOST_BIN_DIR))
 	cmake --build $(HOST_BUILD) -j 2
 
 test-host: host
@@ -163,10 +176,9 @@ bench-large-run: host
 HOST_SANITIZE_BUILD := build/host-asan-$(DESIGN_NAME)
 SANITIZER_ENV := ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1:strict_init_order=1 \
                  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-host-sanitize: deps $(HOST_VERILOG)/filelist.f $(BINNING_PARAMS_DIR)/bpaccel_binning_params.h
+host-sanitize: deps $(HOST_GENERATED)
 	cmake -S host -B $(HOST_SANITIZE_BUILD) -G Ninja -C host/cmake/sanitize.cmake \
-	  -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BIN_DIR=$(abspath $(HOST_SANITIZE_BUILD))/bin \
-	  -DBPACCEL_BINNING_DIR=$(abspath $(BINNING_PARAMS_DIR))
+	  $(HOST_GENERATED_DIRS) -DBPACCEL_BIN_DIR=$(abspath $(HOST_SANITIZE_BUILD))/bin
 	cmake --build $(HOST_SANITIZE_BUILD) -j 2
 
 # CI runs it after `make test` (.ci/run): its build and run take about as long

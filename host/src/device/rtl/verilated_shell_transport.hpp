@@ -1,7 +1,9 @@
 #pragma once
-// The Verilated shell (BpaccelShell) as a ShellTransport: the transport
+// A Verilated shell (BpaccelShell) as a ShellTransport: the transport
 // clocks the model and plays the DMA engine on its two streams and the CPU
-// on its registers, as a PCIe card's XDMA and its host would.
+// on its registers, as a PCIe card's XDMA and its host would. One template
+// for every Verilated shell: the stream width and the clocks come from the
+// model's ports.
 
 #include <chrono>
 #include <cstdint>
@@ -42,13 +44,16 @@ struct VerilatedShellCounters {
   std::uint64_t channelResets = 0;
 };
 
-class VerilatedShellTransport final : public ShellTransport {
+/// `Top`: the Verilated model's class (VBpaccelShell, ...). Instantiated
+/// where the model is built (verilated_shell_transport_impl.hpp).
+template <class Top>
+class VerilatedShellTransportOf final : public ShellTransport {
  public:
   /// Builds the model and holds aresetn low for a few bus cycles.
-  explicit VerilatedShellTransport(VerilatedShellConfig config = {});
-  ~VerilatedShellTransport() override;
-  VerilatedShellTransport(const VerilatedShellTransport&) = delete;
-  VerilatedShellTransport& operator=(const VerilatedShellTransport&) = delete;
+  explicit VerilatedShellTransportOf(VerilatedShellConfig config = {});
+  ~VerilatedShellTransportOf() override;
+  VerilatedShellTransportOf(const VerilatedShellTransportOf&) = delete;
+  VerilatedShellTransportOf& operator=(const VerilatedShellTransportOf&) = delete;
 
   std::uint32_t readRegister(std::uint32_t offset) override;
   void writeRegister(std::uint32_t offset, std::uint32_t value) override;
@@ -80,7 +85,7 @@ class VerilatedShellTransport final : public ShellTransport {
 
   VerilatedShellConfig config_;
   std::unique_ptr<VerilatedContext> context_;
-  std::unique_ptr<VBpaccelShell> top_;
+  std::unique_ptr<Top> top_;
   VerilatedShellCounters counters_;
   // Simulated time (ps) of each clock's next edge.
   std::uint64_t nextBusEdge_ = 0, nextCoreEdge_ = 0;
@@ -96,5 +101,9 @@ class VerilatedShellTransport final : public ShellTransport {
   std::deque<std::vector<std::uint32_t>> completed_;
   LiteAccess read_, write_;
 };
+
+/// The shell of the core this host was built for.
+extern template class VerilatedShellTransportOf<VBpaccelShell>;
+using VerilatedShellTransport = VerilatedShellTransportOf<VBpaccelShell>;
 
 }  // namespace bpaccel

@@ -24,8 +24,11 @@ std::chrono::microseconds remaining(std::chrono::nanoseconds deadline, std::chro
 std::uint32_t ShellDriver::statusRegister() { return BPACCEL_SHELL_REG_STATUS; }
 
 ShellDriver::ShellDriver(ShellTransport& transport, ShellDriverConfig config)
-    : transport_(transport), config_(config), format_(builtShellFormat()) {
-  probeShell(transport_);
+    : ShellDriver(transport, builtShellIdentity(), config) {}
+
+ShellDriver::ShellDriver(ShellTransport& transport, const ShellIdentity& identity, ShellDriverConfig config)
+    : transport_(transport), config_(config), format_(identity.format) {
+  probeShell(transport_, identity);
   if ((status() & kCommandOpen) != 0) recover();  // a process died mid-command
   setUpInterrupts();
   waitReady();

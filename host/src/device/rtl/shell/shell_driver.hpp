@@ -11,6 +11,7 @@
 #include "cells_codec.hpp"
 #include "frame_codec.hpp"
 #include "shell_format.hpp"
+#include "shell_identity.hpp"
 #include "shell_reply.hpp"
 #include "shell_transport.hpp"
 
@@ -40,18 +41,19 @@ struct ShellDriverEvents {
   std::uint32_t lastIrqStatus = 0; // IRQ_STATUS as the last interrupt found it
 };
 
-/// Drives one shell through a transport. Built for the shell whose headers
-/// (bpaccel_shell.h, bpaccel_params.h) this program includes. Not thread-safe:
+/// Drives one shell through a transport: the shell of `identity`, by default
+/// the one this program was built for (builtShellIdentity). Not thread-safe:
 /// one thread issues commands, one at a time.
 class ShellDriver {
  public:
   /// Probes the shell (ID, VERSION, the capability registers and FINGERPRINT
-  /// against bpaccel_shell.h; throws ShellProbeError naming the first
+  /// against `identity`; throws ShellProbeError naming the first
   /// difference), recovers it if a command was left open, sets up its
   /// interrupts and waits for READY.
+  ShellDriver(ShellTransport& transport, const ShellIdentity& identity, ShellDriverConfig config = {});
   explicit ShellDriver(ShellTransport& transport, ShellDriverConfig config = {});
 
-  /// The layout of the shell's packets (the built one, as probed).
+  /// The layout of the shell's packets (as probed).
   const ShellFormat& format() const { return format_; }
   const ShellDriverEvents& events() const { return events_; }
 

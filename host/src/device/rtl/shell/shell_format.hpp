@@ -8,7 +8,7 @@
 namespace bpaccel {
 
 /// The layout of one shell's packets and the limits of its device. The
-/// driver takes the built one (builtShellFormat, from the generated headers)
+/// driver takes its shell's (ShellIdentity, from the generated bpaccel_shell.h)
 /// and checks it against the device's registers when it probes; the codecs
 /// take any, so they can be tested on layouts other than the built one.
 struct ShellFormat {

@@ -27,13 +27,13 @@ class FakeShellTransport final : public ShellTransport {
     regs[BPACCEL_SHELL_REG_ID] = BPACCEL_SHELL_REG_ID_RESET;
     regs[BPACCEL_SHELL_REG_VERSION] = BPACCEL_SHELL_REG_VERSION_RESET;
     regs[BPACCEL_SHELL_REG_FINGERPRINT] = BPACCEL_SHELL_FINGERPRINT;
-    for (const ExpectedRegister& r : builtCapabilities()) regs[r.offset] = r.value;
+    for (const ExpectedRegister& r : builtShellIdentity().capabilities) regs[r.offset] = r.value;
     regs[BPACCEL_SHELL_REG_STATUS] = BPACCEL_SHELL_REG_STATUS_READY_MASK;
   }
 
   // What the device does with a packet: by default, the reference device's reply.
   std::function<std::vector<std::uint32_t>(const std::vector<std::uint32_t>&)> answer =
-      [](const std::vector<std::uint32_t>& packet) { return referenceCellsReply(builtShellFormat(), packet); };
+      [](const std::vector<std::uint32_t>& packet) { return referenceCellsReply(builtShellIdentity().format, packet); };
   int silentCommands = 0;       // the next commands get no reply (a hang)
   bool answersAbort = true;     // CONTROL.ABORT of a silent command gives an ABORTED trailer
   bool abortLeavesInPacket = false;  // ... with STATUS.IN_PACKET still set
@@ -63,7 +63,7 @@ class FakeShellTransport final : public ShellTransport {
         --hung_;
         ReferenceTrailer t;
         t.error = BPACCEL_SHELL_ERR_ABORTED;
-        deliver(packReply(builtShellFormat(), {}, t));
+        deliver(packReply(builtShellIdentity().format, {}, t));
         if (abortLeavesInPacket) regs[BPACCEL_SHELL_REG_STATUS] |= BPACCEL_SHELL_REG_STATUS_IN_PACKET_MASK;
       }
     } else if (offset == BPACCEL_SHELL_REG_CONTROL && (value & BPACCEL_SHELL_REG_CONTROL_SOFT_RESET_MASK)) {

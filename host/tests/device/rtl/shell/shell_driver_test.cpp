@@ -57,7 +57,7 @@ TEST(ShellDriverProbe, ChecksIdentityAndCapabilitiesThenClearsAndEnablesInterrup
     FakeShellTransport t;
     ShellDriver driver(t, quick(interrupts));
     EXPECT_EQ(t.log.front(), readOf(BPACCEL_SHELL_REG_ID));
-    for (const ExpectedRegister& r : builtCapabilities()) EXPECT_LT(find(t, readOf(r.offset)), t.log.size()) << r.name;
+    for (const ExpectedRegister& r : builtShellIdentity().capabilities) EXPECT_LT(find(t, readOf(r.offset)), t.log.size()) << r.name;
     const std::size_t clear = find(t, writeOf(BPACCEL_SHELL_REG_IRQ_STATUS, kIrqBoth));
     const std::size_t enable = find(t, writeOf(BPACCEL_SHELL_REG_IRQ_ENABLE, interrupts ? kIrqBoth : 0u));
     EXPECT_LT(clear, enable);  // stale causes cleared before the line is enabled
@@ -146,7 +146,7 @@ TEST(ShellDriverCommand, AnErrorTrailerThrowsItsNameAndDetailAndKeepsNothing) {
   FakeShellTransport t;
   t.answer = [](const std::vector<std::uint32_t>& packet) {
     ReferenceTrailer trailer{.error = BPACCEL_SHELL_ERR_COUNT_OVER_CAPACITY, .detail = 1};
-    auto reply = referenceCellsReply(builtShellFormat(), packet);  // records sent before the error was found
+    auto reply = referenceCellsReply(builtShellIdentity().format, packet);  // records sent before the error was found
     const auto end = trailerWords(trailer);
     std::copy(end.begin(), end.end(), reply.end() - 16);
     return reply;
@@ -234,14 +234,14 @@ TEST(ShellDriverReply, ABrokenReplyRecoversTheShellAndSaysWhy) {
   std::vector<Pair> out;
   std::vector<std::size_t> ends;
   t.answer = [](const std::vector<std::uint32_t>& packet) {  // a reply to another command
-    auto reply = referenceCellsReply(builtShellFormat(), packet);
+    auto reply = referenceCellsReply(builtShellIdentity().format, packet);
     reply[reply.size() - 16] ^= 0x3u << 16;
     return reply;
   };
   EXPECT_THROW(driver.runCells(cells.command(), out, ends), ShellProtocolError);
   EXPECT_EQ(driver.events().recoveries, 1u);
   t.answer = [](const std::vector<std::uint32_t>& packet) {  // more records than the posted buffer holds
-    auto reply = referenceCellsReply(builtShellFormat(), packet);
+    auto reply = referenceCellsReply(builtShellIdentity().format, packet);
     reply.insert(reply.begin(), 64 * BPACCEL_SHELL_WORDS_PER_BEAT, 0u);
     return reply;
   };
@@ -261,7 +261,7 @@ TEST(ShellDriverFrame, EncodesSendsAndDecodesAFrameThroughTheSameSequence) {
   const std::vector<KeyBox> boxes = {unitBox(0), unitBox(1), unitBox(5)};
   t.answer = [&](const std::vector<std::uint32_t>& packet) {
     EXPECT_EQ(packet[0], 0x0101u);
-    const ShellFormat f = builtShellFormat();
+    const ShellFormat f = builtShellIdentity().format;
     return packReply(f, {indexWords(f, 0, 1)}, {.opcode = BPACCEL_SHELL_OP_FRAME, .records = 1, .boxes = 3,
                                                 .pairs = 1});
   };
