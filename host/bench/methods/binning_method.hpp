@@ -3,6 +3,8 @@
 // the device's cycles from its cycle-exact C++ model, the link modelled, on a
 // named DeviceProfile.
 
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -37,28 +39,53 @@ BinningFrameModel modelBinningFrame(const BinningFrameStats& stats, const Binnin
 /// stream (docs/protocol.md): what its driver encodes and decodes.
 ShellFormat binningShellFormat(const BinningParams& params);
 
-/// The card as the bench models it, in front of a FrameDevice model: the
-/// driver's work on the host runs for real (each frame's FRAME packet encoded,
-/// the reply's records decoded into the pairs the model found), and the
-/// card's own work (the model's run, the reply's words it sends) is timed
-/// apart in `seconds`, which is no host work.
+/// The card as the bench models it, in front of a FrameDevice model. The
+/// driver's work on the host runs for real (each frame's FRAME packet
+/// encoded, the reply's records decoded); the card's own work is no host
+/// work and is timed apart in `seconds`. Two modes:
+///   record: each command runs on the model, and its reply (with the words
+///           the card would send) is kept;
+///   replay: each command gets the next kept reply, after a check that it is
+///           the command recorded (n, grid, a sample of its keys).
+/// A frame replayed runs the host's steps with no simulation between them:
+/// a real card does not evict the host's caches while it works, the model
+/// would (the decode rereads every pair's boxes).
 class ModelledFrameCard final : public FrameDevice {
  public:
   explicit ModelledFrameCard(FrameDevice& inner) : inner_(inner), format_(binningShellFormat(inner.params())) {}
   std::string name() const override { return inner_.name(); }
   const BinningParams& params() const override { return inner_.params(); }
   FrameReply runFrame(const FrameCommand& command) override;
+  /// Forgets the kept replies and records the next commands' replies.
+  void record();
+  /// Replays the kept replies from the first; throws std::logic_error from runFrame for a command that differs.
+  void replay();
   double seconds = 0;
 
  private:
+  struct Kept {
+    std::size_t n = 0;
+    unsigned shift = 0;
+    std::array<unsigned, 3> dims{};
+    std::uint64_t sample = 0;  // a hash of up to 64 of the command's boxes
+    FrameReply reply;
+    std::vector<std::uint32_t> words;
+  };
+  static std::uint64_t sampleOf(const FrameCommand& command);
+
   FrameDevice& inner_;
   ShellFormat format_;
-  std::vector<std::uint32_t> packet_, reply_;
+  std::vector<std::uint32_t> packet_;
+  std::vector<Kept> kept_;
+  std::size_t next_ = 0;
+  bool replaying_ = false;
 };
 
-/// "accelerator binning on <profile>": BinningFrame on a BinningModel.
-/// Host = the measured frame minus the time spent simulating the device
-/// (every runFrame, retries too; the host's own work between them counts).
+/// "accelerator binning on <profile>": BinningFrame on a BinningModel, each
+/// update twice: once with the card recording (the model's replies), then
+/// with it replaying them while the host's steps are timed. Host = the
+/// measured update minus the recording pass and the card's own time in the
+/// replay (the host's own work between commands, retries too, counts).
 class BinningMethod final : public TimedMethod {
  public:
   BinningMethod(const BinningParams& params, DeviceProfile profile);

@@ -115,5 +115,45 @@ TEST(BinningMethod, TheModelledCardRunsTheDriversEncodingAndDecodingAndReturnsTh
   EXPECT_THROW(card.runFrame(FrameCommand{wide, 0, {1, 1, 1}, std::nullopt}), std::invalid_argument);
 }
 
+/// A FrameDevice that counts the frames it runs, in front of a model.
+class CountingDevice final : public FrameDevice {
+ public:
+  explicit CountingDevice(FrameDevice& inner) : inner_(inner) {}
+  std::string name() const override { return inner_.name(); }
+  const BinningParams& params() const override { return inner_.params(); }
+  FrameReply runFrame(const FrameCommand& command) override { return ++runs, inner_.runFrame(command); }
+  std::size_t runs = 0;
+
+ private:
+  FrameDevice& inner_;
+};
+
+TEST(BinningMethod, TheReplayGivesTheRecordedRepliesWithoutRunningTheModelAndRefusesAnotherCommand) {
+  BinningParams small = builtBinningParams();
+  small.boxCapacity = 1000;  // 3000 boxes: several frames
+  BinningModel model(small);
+  CountingDevice counted(model);
+  ModelledFrameCard card(counted);
+  BinningFrame frame(card);
+  const auto boxes = testing::scatteredBoxes(3000, 5, 0, 40, 0.3f, 2.5f);
+  std::vector<Pair> recorded, replayed;
+  card.record();
+  frame.findPairs(boxes, recorded);
+  const std::size_t runs = counted.runs;
+  const BinningFrameStats first = frame.stats();
+  EXPECT_GE(runs, 3u);
+  card.replay();
+  frame.findPairs(boxes, replayed);
+  EXPECT_EQ(counted.runs, runs) << "the replay ran the model";
+  EXPECT_EQ(testing::sorted(replayed), testing::sorted(recorded));
+  EXPECT_EQ(testing::sorted(replayed), testing::bruteForce(boxes));
+  EXPECT_EQ(frame.stats().deviceCycles, first.deviceCycles);
+  EXPECT_EQ(frame.stats().frames, first.frames);
+  // Another scene's commands are not the recorded ones.
+  card.replay();
+  const auto moved = testing::scatteredBoxes(3000, 6, 0, 40, 0.3f, 2.5f);
+  EXPECT_THROW(frame.findPairs(moved, replayed), std::logic_error);
+}
+
 }  // namespace
 }  // namespace bpaccel
