@@ -119,7 +119,7 @@ void BinningMethod::update(std::span<const Aabb> boxes) {
   frame_.collect(pairs_);
   const auto t3 = Clock::now();
   simulationSeconds_ = seconds(r0, r1) + timed_.seconds;
-  planSeconds_ = seconds(t0, t1), driverSeconds_ = seconds(t1, t2) - simulationSeconds_, collectSeconds_ = seconds(t2, t3);
+  planSeconds_ = seconds(t0, t1), driverSeconds_ = seconds(t1, t2) - timed_.seconds, collectSeconds_ = seconds(t2, t3);
 }
 
 FrameTime BinningMethod::frameTime(double measuredSeconds) const {

@@ -58,6 +58,9 @@ TEST(BinningMethod, FindsTheExactPairsAndCountsOnlyHostWorkAsHost) {
   EXPECT_GT(t.parts->deviceSeconds, 0);
   EXPECT_EQ(t.parts->stats.boxesSent, 500u);
   EXPECT_DOUBLE_EQ(t.seconds, t.parts->hostSeconds + t.parts->deviceSeconds + t.parts->transferSeconds);
+  EXPECT_GE(method.planSeconds(), 0.0);
+  EXPECT_GE(method.driverSeconds(), 0.0);
+  EXPECT_GE(method.collectSeconds(), 0.0);
 }
 
 TEST(BinningMethod, RunsAtTheBinningDesignsOwnClockWhereItsReportOnThePartIsValidElseTheStreamsStandsIn) {
