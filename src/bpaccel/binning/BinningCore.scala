@@ -57,9 +57,13 @@ class BinningCore(val p: BinningParams) extends Module {
   control.io.groupsDone  := groups.map(_.io.done).reduce(_ && _)
   control.io.outputEmpty := groups.map(_.io.empty).reduce(_ && _) && merge.io.empty
   // Sums and the maximum over the groups, registered: they settle long before the summary.
-  control.io.entries    := RegNext(groups.map(_.io.entries.pad(32)).reduce(_ + _))
-  control.io.maxEntries := RegNext(groups.map(_.io.entries.pad(32)).reduce((a, b) => Mux(a > b, a, b)))
-  control.io.issueCycles := RegNext(groups.map(_.io.issues.pad(p.counterWidth)).reduce(_ + _))
+  // Balanced trees at the groups' own widths (sums widen a bit a level), so
+  // the depth grows with log2 G, not G.
+  private def sum(xs: Seq[UInt]): UInt = VecInit(xs).reduceTree(_ +& _)
+  control.io.entries    := RegNext(sum(groups.map(_.io.entries)).pad(32))
+  control.io.maxEntries := RegNext(VecInit(groups.map(_.io.entries)).reduceTree((a, b) => Mux(a > b, a, b)).pad(32))
+  private val issueSum = sum(groups.map(_.io.issues))
+  control.io.issueCycles := RegNext(issueSum(issueSum.getWidth.min(p.counterWidth) - 1, 0).pad(p.counterWidth))
 
   control.io.pairsOffered := io.pairs.valid
   control.io.pairsTaken   := Mux(io.pairs.fire, PopCount(io.pairs.bits.pairs.map(_.valid)), 0.U)
