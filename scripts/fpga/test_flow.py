@@ -3,6 +3,8 @@
 architecture): a real synthesis, place and route, and a report with every
 field the benchmark and the docs rely on. Run by `make test-fpga` (part of
 `make test`) as `python3 scripts/fpga/test_flow.py <seed-m2-dir> <stream-m2-dir>`."""
+import contextlib
+import io
 import json
 import subprocess
 import sys
@@ -12,7 +14,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))  # the flow's package, for the tests that need no tools
-from fpgaflow import design, ecp5, names, tools  # noqa: E402
+from fpgaflow import design, ecp5, names, report, tools  # noqa: E402
 
 VERILOG_DIRS: dict[str, Path] = {}
 FLOWS: dict[str, tuple[subprocess.Popen, Path, Path, Path]] = {}  # arch: (its run, report, work dir, output)
@@ -190,6 +192,16 @@ class BinningDeviceParameters(unittest.TestCase):
         self.assertEqual((ok["dp16kd"], ok["dp16kd_estimate"], ok["lut_ram_trellis_dpr16x4"]), (160, 160, 768))
         one_in_lut_ram = log.replace("PDPW16KD", "TRELLIS_DPR16X4", 1)
         self.assertFalse(ecp5.memories(core, cells, one_in_lut_ram + tables, [])["memories_in_bram"])
+
+        # A routed report's summary names the mapping it has (all memories'), not the other architectures' field.
+        routed = {"arch": "binning", "m": 64, "capacity": 8192, "part": {"ecp5": "LFE5UM5G-85F"}, "status": "ok",
+                  "ecp5": {"luts": 1, "ffs": 1, "bram_dp16kd": 160, "fmax_mhz": 100.0, "clock_constraint_mhz": 200,
+                           "timing_met": False, "pair_tests_per_second": 6.4e9},
+                  "memories": ok, "runtime_s": {}}
+        printed = io.StringIO()
+        with contextlib.redirect_stdout(printed):
+            report.print_summary(routed)
+        self.assertIn("memories in block RAM: True ({'$__ECP5_PDPW16KD_': 64", printed.getvalue())
 
 
 class FlowRefusesBadInput(unittest.TestCase):

@@ -136,7 +136,9 @@ def print_summary(r: dict) -> None:
               f"Fmax {e['fmax_mhz']} MHz (constraint {e['clock_constraint_mhz']:g} MHz, "
               f"{'met' if e['timing_met'] else 'NOT met'})")
         print(f"   pair tests/s = m x Fmax = {e['pair_tests_per_second'] / 1e9:.3f} G")
-        print(f"   memories in block RAM: {r['memories']['memories_in_bram']} ({r['memories']['ecp5_mapping']})")
+        mems = r["memories"]  # the binning device's report lists all its memories' mapping only
+        print(f"   memories in block RAM: {mems['memories_in_bram']} "
+              f"({mems.get('ecp5_mapping', mems.get('ecp5_mapping_all_memories'))})")
     x = r.get("xilinx_estimate")
     if x:
         print(f"   Xilinx xc7 estimate (synthesis only): {x['luts']} LUT, {x['ffs']} FF, "

@@ -56,10 +56,21 @@ class BinningCore(val p: BinningParams) extends Module {
   control.io.groupsIdle  := groups.map(_.io.intakeIdle).reduce(_ && _)
   control.io.groupsDone  := groups.map(_.io.done).reduce(_ && _)
   control.io.outputEmpty := groups.map(_.io.empty).reduce(_ && _) && merge.io.empty
-  // Sums and the maximum over the groups, registered: they settle long before the summary.
-  control.io.entries    := RegNext(groups.map(_.io.entries.pad(32)).reduce(_ + _))
-  control.io.maxEntries := RegNext(groups.map(_.io.entries.pad(32)).reduce((a, b) => Mux(a > b, a, b)))
-  control.io.issueCycles := RegNext(groups.map(_.io.issues.pad(p.counterWidth)).reduce(_ + _))
+  // Sums and the maximum over the groups, as balanced trees at the groups'
+  // own widths (sums widen a bit a level) cut into two registered halves of
+  // their depth. Two cycles late is still in time for the summary: a group's
+  // entry count stops at least two cycles before the intake ends, which is
+  // at least localCells cycles before the summary; its issue count stops
+  // three cycles before the group is done (compare, AND, then idle).
+  private def twoStages(xs: Seq[UInt])(op: (UInt, UInt) => UInt): UInt = {
+    def registered(x: UInt): UInt = { val r = Reg(chiselTypeOf(x)); r := x; r } // keeps the width (RegNext drops it)
+    val chunk = 1 << ((log2Ceil(xs.length) + 1) / 2)
+    registered(VecInit(xs.grouped(chunk).map(c => registered(VecInit(c).reduceTree(op))).toSeq).reduceTree(op))
+  }
+  control.io.entries    := twoStages(groups.map(_.io.entries))(_ +& _).pad(32)
+  control.io.maxEntries := twoStages(groups.map(_.io.entries))((a, b) => Mux(a > b, a, b)).pad(32)
+  private val issueSum = twoStages(groups.map(_.io.issues))(_ +& _)
+  control.io.issueCycles := issueSum(issueSum.getWidth.min(p.counterWidth) - 1, 0).pad(p.counterWidth)
 
   control.io.pairsOffered := io.pairs.valid
   control.io.pairsTaken   := Mux(io.pairs.fire, PopCount(io.pairs.bits.pairs.map(_.valid)), 0.U)

@@ -63,12 +63,19 @@ object BoxCells {
     d
   }
 
+  /** Whether a decoded box covers a cell of group `group` (whatever its error). */
+  def covers(p: BinningParams, d: BoxCells, group: Int): Bool = parts(p, d, group).map(_.valid).reduce(_ && _)
+
+  private def parts(p: BinningParams, d: BoxCells, group: Int): Seq[Valid[AxisPart]] = {
+    val classOf = (0 until 3).map(a => (group >> p.groupBits.take(a).sum) & ((1 << p.groupBits(a)) - 1))
+    (0 until 3).map(a => d.parts(a)(classOf(a)))
+  }
+
   /** The entry a decoded box makes in group `group` (valid when it covers a cell of that group). */
   def entry(p: BinningParams, d: BoxCells, group: Int): Valid[BinEntry] = {
     val e = Wire(Valid(new BinEntry(p)))
-    val classOf = (0 until 3).map(a => (group >> p.groupBits.take(a).sum) & ((1 << p.groupBits(a)) - 1))
-    val parts = (0 until 3).map(a => d.parts(a)(classOf(a)))
-    e.valid := d.valid && d.error === BinningError.None && parts.map(_.valid).reduce(_ && _)
+    val parts = this.parts(p, d, group)
+    e.valid := d.valid && d.error === BinningError.None && covers(p, d, group)
     for (a <- 0 until 3) {
       e.bits.min(a)    := parts(a).bits.min
       e.bits.max(a)    := parts(a).bits.max
@@ -84,8 +91,14 @@ object BoxCells {
 /** What the intake offers one group in a cycle, and whether the group takes it. */
 class GroupPush(p: BinningParams) extends Bundle {
   val offer = Output(Vec(p.intakeBoxes, Valid(new BinEntry(p)))) // the held beat's entries for this group, by lane
-  val room  = Input(Bool())  // the group can queue `offer` in this cycle
+  val room  = Input(new QueueRoom(p)) // which of the group's queues can take one more in this cycle
   val push  = Output(Bool()) // it does
+}
+
+/** Which of a group's intake queues have room: its beat queue and each lane's entry queue. */
+class QueueRoom(p: BinningParams) extends Bundle {
+  val beat  = Bool()
+  val lanes = Vec(p.intakeBoxes, Bool())
 }
 
 /** Takes the frame's boxes, numbers them in stream order, decodes each
@@ -122,10 +135,13 @@ class Intake(p: BinningParams) extends Module {
   val errorRaised = RegInit(false.B)
   val held        = RegInit(false.B)
   val beat        = Reg(Vec(w, new BoxCells(p)))
-  val beatLast    = Reg(Bool())
   val beatEnd     = Reg(UInt(32.W)) // boxes received once this beat is counted
-  // Entries each group may still take (GROUP_OVERFLOW past it).
+  val count       = PopCount(io.boxes.bits.boxes.map(_.valid))
+  // Entries each group may still take (GROUP_OVERFLOW past it), and the same capped at w: a beat
+  // brings at most w entries to a group, so comparing with the capped room needs no wide compare.
   val room = RegInit(VecInit(Seq.fill(p.groups)(p.groupCapacity.U(p.entryCountWidth.W))))
+  private def capped(r: UInt): UInt = Mux(r >= w.U, w.U, r(log2Ceil(w + 1) - 1, 0))
+  val cappedRoom = RegInit(VecInit(Seq.fill(p.groups)(p.groupCapacity.min(w).U(log2Ceil(w + 1).W))))
 
   assert(!io.boxes.valid || (1 until w).map(l => !io.boxes.bits.boxes(l).valid || io.boxes.bits.boxes(l - 1).valid).foldLeft(true.B)(_ && _),
     "a beat of boxes is not filled from its lowest lane")
@@ -134,7 +150,7 @@ class Intake(p: BinningParams) extends Module {
   val entries = Seq.tabulate(p.groups, w)((gr, l) => BoxCells.entry(p, beat(l), gr))
   val over = Seq.tabulate(p.groups, w) { (gr, l) =>
     val upTo = PopCount(entries(gr).take(l + 1).map(_.valid))
-    entries(gr)(l).valid && upTo > room(gr)
+    entries(gr)(l).valid && upTo > cappedRoom(gr)
   }
   val laneError = Seq.tabulate(w) { l =>
     val code = Wire(BinningError())
@@ -143,11 +159,23 @@ class Intake(p: BinningParams) extends Module {
     (beat(l).valid && code =/= BinningError.None, code)
   }
   val anyLaneError = laneError.map(_._1).reduce(_ || _)
-  val endsShort    = beatLast && beatEnd < io.n
-  val raises       = held && !errorRaised && (anyLaneError || endsShort)
-  val groupRoom    = (0 until p.groups).map(gr => !entries(gr).map(_.valid).reduce(_ || _) || io.groups(gr).room)
-  val pushes       = held && !errorRaised && !raises && groupRoom.reduce(_ && _)
-  val moves        = held && (errorRaised || raises || pushes)
+  // Whether the beat moves is decided every cycle across all groups, so it is
+  // computed flat: a lane's own error, else a group's entries beyond its room
+  // (counted without the error term, which only matters when a lane's own
+  // error raises anyway), else the last beat short of n (decided when the
+  // beat was taken: n is fixed during the intake).
+  val boxError  = (0 until w).map(l => beat(l).valid && beat(l).error =/= BinningError.None).reduce(_ || _)
+  val covers    = Seq.tabulate(p.groups, w)((gr, l) => beat(l).valid && BoxCells.covers(p, beat(l), gr))
+  val overflows = (0 until p.groups).map(gr => PopCount(covers(gr)) > cappedRoom(gr))
+  val endsShort = RegEnable(io.boxes.bits.last && received + count < io.n, io.boxes.fire) // of the held beat
+  val raising   = boxError || overflows.reduce(_ || _) || endsShort
+  val raises    = held && !errorRaised && raising
+  val queued    = (0 until p.groups).map { gr =>
+    val r = io.groups(gr).room
+    !covers(gr).reduce(_ || _) || (r.beat && covers(gr).zip(r.lanes).map { case (c, free) => !c || free }.reduce(_ && _))
+  }
+  val pushes = held && !errorRaised && !raising && queued.reduce(_ && _)
+  val moves  = held && (errorRaised || raises || pushes)
 
   io.error.valid := raises
   io.error.bits.code := Mux(anyLaneError, PriorityMux(laneError.map(_._1), laneError.map(_._2)), BinningError.LengthMismatch)
@@ -156,18 +184,17 @@ class Intake(p: BinningParams) extends Module {
 
   for (gr <- 0 until p.groups) {
     io.groups(gr).offer := VecInit(entries(gr))
-    io.groups(gr).push  := pushes && entries(gr).map(_.valid).reduce(_ || _)
-    when(pushes) { room(gr) := room(gr) - PopCount(entries(gr).map(_.valid)) }
+    io.groups(gr).push  := pushes && covers(gr).reduce(_ || _)
+    val left = room(gr) - PopCount(covers(gr))
+    when(pushes) { room(gr) := left; cappedRoom(gr) := capped(left) }
   }
 
   // ---- taking the next beat ----
   io.boxes.ready := io.active && !lastTaken && (!held || moves)
-  val count = PopCount(io.boxes.bits.boxes.map(_.valid))
   if (p.has(BinningFault.ReceivedCountsOffers)) when(io.boxes.valid && !io.boxes.ready) { received := received + count }
   when(io.boxes.fire) {
     for (l <- 0 until w)
       beat(l) := BoxCells(p, io.boxes.bits.boxes(l), received + l.U, io.n, io.shift, io.dims)
-    beatLast := io.boxes.bits.last
     beatEnd  := received + count
     received := received + count
     when(io.boxes.bits.last) { lastTaken := true.B }
@@ -179,7 +206,7 @@ class Intake(p: BinningParams) extends Module {
     lastTaken   := false.B
     errorRaised := io.headerError
     held        := false.B
-    for (gr <- 0 until p.groups) room(gr) := p.groupCapacity.U
+    for (gr <- 0 until p.groups) { room(gr) := p.groupCapacity.U; cappedRoom(gr) := p.groupCapacity.min(w).U }
   }
 
   io.lastTaken := lastTaken

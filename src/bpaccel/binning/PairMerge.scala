@@ -80,7 +80,8 @@ class PairMerge(p: BinningParams) extends Module {
   val offered = heads.map(_.valid)
   output.io.enq.valid := offered.reduce(_ || _)
   // Lane k of the beat takes the k-th cluster that offers a pair.
-  val rank = offered.scanLeft(0.U(log2Ceil(lanes + 1).W))((sum, v) => sum + v.asUInt)
+  // Each cluster's rank is its own count of the clusters before it that offer (a tree each, not one chain of adders).
+  val rank = offered.indices.map(c => if (c == 0) 0.U else PopCount(offered.take(c)))
   for (k <- 0 until lanes) {
     val picks = heads.indices.map(c => offered(c) && rank(c) === k.U)
     output.io.enq.bits.pairs(k).valid := picks.reduce(_ || _)
