@@ -76,20 +76,6 @@ AxisBounds BinningFrame::keepFitting(std::vector<std::uint32_t>& ids) {
   return bounds;
 }
 
-bool Region::bounded() const {
-  for (int a = 0; a < 3; ++a)
-    if (std::isfinite(lo[a]) || std::isfinite(hi[a])) return true;
-  return false;
-}
-
-bool Region::owns(const Aabb& a, const Aabb& b) const {
-  for (int x = 0; x < 3; ++x) {
-    const double corner = std::max(a.min[x], b.min[x]);
-    if (!(corner >= lo[x] && corner < hi[x])) return false;
-  }
-  return true;
-}
-
 void BinningFrame::planRegions(std::span<const std::uint32_t> ids, const AxisBounds& bounds) {
   // About 90 % of the capacity a region, in a grid over the two longest axes, as square as the scene's
   // extent on them allows: a thin slab spans few cells across, leaving lane groups idle while the
@@ -103,49 +89,9 @@ void BinningFrame::planRegions(std::span<const std::uint32_t> ids, const AxisBou
   const auto first = std::clamp<std::size_t>(
       static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(regions) * ratio))), 1, regions);
   const std::size_t second = (regions + first - 1) / first;
-  for (auto& [slabIds, slab] : cut(ids, Region{}, axes[0], first))
-    for (auto& [partIds, part] : cut(slabIds, slab, axes[1], second))
+  for (auto& [slabIds, slab] : cutter_.cut(boxes_, ids, Region{}, axes[0], first))
+    for (auto& [partIds, part] : cutter_.cut(boxes_, slabIds, slab, axes[1], second))
       if (!partIds.empty()) frames_.push_back(makeFrame(std::move(partIds), part));
-}
-
-std::vector<std::pair<std::vector<std::uint32_t>, Region>> BinningFrame::cut(std::span<const std::uint32_t> ids,
-                                                                             const Region& outer, int axis,
-                                                                             std::size_t parts) {
-  // The cuts: near the quantiles k / parts of the mins, at the edges of a histogram's bins (one pass; any
-  // cut keeps the frame exact, the quantiles only balance the parts).
-  double least = HUGE_VAL, most = -HUGE_VAL;
-  for (std::uint32_t i : ids) least = std::min(least, double{boxes_[i].min[axis]}), most = std::max(most, double{boxes_[i].min[axis]});
-  std::vector<double> cuts{outer.lo[axis]};
-  constexpr std::size_t kBins = 4096;
-  if (parts > 1 && most > least && std::isfinite(most - least)) {
-    const double width = (most - least) / kBins;
-    std::vector<std::uint32_t> count(kBins + 1);
-    for (std::uint32_t i : ids)
-      count[std::min(kBins, static_cast<std::size_t>((boxes_[i].min[axis] - least) / width))] += 1;
-    std::size_t seen = 0, k = 1;
-    for (std::size_t bin = 0; bin <= kBins && k < parts; ++bin) {
-      seen += count[bin];
-      const double edge = least + static_cast<double>(bin + 1) * width;  // above every min of bins 0 .. bin
-      if (seen >= k * ids.size() / parts && edge > cuts.back() && edge < outer.hi[axis] && edge <= most) {
-        cuts.push_back(edge);
-        while (k < parts && seen >= k * ids.size() / parts) ++k;
-      }
-    }
-  }
-  cuts.push_back(outer.hi[axis]);
-  std::vector<std::pair<std::vector<std::uint32_t>, Region>> out(cuts.size() - 1);
-  for (std::size_t k = 0; k < out.size(); ++k) {
-    out[k].first.reserve(ids.size() / out.size() + ids.size() / 8);  // a share, and room for the boxes across cuts
-    out[k].second = outer;
-    out[k].second.lo[axis] = cuts[k], out[k].second.hi[axis] = cuts[k + 1];
-  }
-  // Each box into every slab it meets, from the one holding its min (or the first) on.
-  for (std::uint32_t i : ids) {
-    auto k = static_cast<std::size_t>(std::upper_bound(cuts.begin() + 1, cuts.end() - 1, double{boxes_[i].min[axis]}) -
-                                      cuts.begin() - 1);
-    for (; k < out.size() && out[k].second.meets(boxes_[i], axis); ++k) out[k].first.push_back(i);
-  }
-  return out;
 }
 
 PlannedFrame BinningFrame::takeSpare() {
@@ -243,7 +189,7 @@ bool BinningFrame::split(const PlannedFrame& f, std::vector<PlannedFrame>& todo)
   const auto length = [&](int a) { return f.grid.unit[a] * f.grid.dims[a]; };
   std::sort(axes.begin(), axes.end(), [&](int x, int y) { return length(x) > length(y); });
   for (int axis : axes) {
-    auto halves = cut(f.ids, f.region, axis, 2);
+    auto halves = cutter_.cut(boxes_, f.ids, f.region, axis, 2);
     // A cut helps when each half holds fewer boxes than the frame (all mins equal on the axis: none does).
     const auto smaller = [&](const auto& half) { return !half.first.empty() && half.first.size() < f.ids.size(); };
     if (halves.size() < 2 || !std::all_of(halves.begin(), halves.end(), smaller)) continue;

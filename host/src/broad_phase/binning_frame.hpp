@@ -11,6 +11,7 @@
 #include "../core/types.hpp"
 #include "../device/binning/frame_device.hpp"
 #include "binning_grid.hpp"
+#include "slab_cutter.hpp"
 
 namespace bpaccel {
 
@@ -26,19 +27,6 @@ struct BinningFrameStats {
   std::uint64_t deviceCycles = 0;  // summed over the frames sent, refused ones too
   std::uint64_t issueCycles = 0;
   FramePhases phases;              // summed over the frames that returned pairs
-};
-
-/// A part of space, [lo, hi) on each axis (unbounded: the infinities). It
-/// owns the pairs whose intersection's low corner (the greater min on each
-/// axis) lies in it: regions that tile space own each pair once.
-struct Region {
-  std::array<double, 3> lo{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  std::array<double, 3> hi{HUGE_VAL, HUGE_VAL, HUGE_VAL};
-  bool bounded() const;
-  /// Whether the region owns the pair of overlapping boxes a, b.
-  bool owns(const Aabb& a, const Aabb& b) const;
-  /// Whether box b meets the region on `axis`: [lo, hi) meets [min, max] when min < hi and max >= lo.
-  bool meets(const Aabb& b, int axis) const { return b.min[axis] < hi[axis] && b.max[axis] >= lo[axis]; }
 };
 
 /// One device frame of the plan: the boxes it carries (global ids, in stream
@@ -86,10 +74,6 @@ class BinningFrame {
   AxisBounds keepFitting(std::vector<std::uint32_t>& ids);
   /// Cuts the scene's fitting boxes `ids` (within `bounds`) into regions, each a frame of frames_.
   void planRegions(std::span<const std::uint32_t> ids, const AxisBounds& bounds);
-  /// Cuts `outer` on `axis` into up to `parts` slabs at quantiles of the mins of `ids`: their boxes (each
-  /// in every slab it meets) and their regions.
-  std::vector<std::pair<std::vector<std::uint32_t>, Region>> cut(std::span<const std::uint32_t> ids,
-                                                                  const Region& outer, int axis, std::size_t parts);
   /// A frame of spare_, its buffers' capacity kept from an earlier frame, or a new one.
   PlannedFrame takeSpare();
   /// The frame of boxes `ids` owning `region`, with its grid and keys.
@@ -112,6 +96,7 @@ class BinningFrame {
   std::vector<std::uint32_t> longIds_;
   std::vector<std::uint8_t> isLong_;
   std::vector<Pair> hostPairs_;  // of regions no cut could shrink
+  SlabCutter cutter_;
   BinningFrameStats stats_;
 };
 

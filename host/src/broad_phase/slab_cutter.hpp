@@ -1,0 +1,46 @@
+#pragma once
+// Regions of space and the cut of a set of boxes into slabs of them: the
+// binning device's host path sends a scene above the device's capacity as
+// regions, each box to every region it meets.
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "../core/types.hpp"
+
+namespace bpaccel {
+
+/// A part of space, [lo, hi) on each axis (unbounded: the infinities). It
+/// owns the pairs whose intersection's low corner (the greater min on each
+/// axis) lies in it: regions that tile space own each pair once.
+struct Region {
+  std::array<double, 3> lo{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  std::array<double, 3> hi{HUGE_VAL, HUGE_VAL, HUGE_VAL};
+  bool bounded() const;
+  /// Whether the region owns the pair of overlapping boxes a, b.
+  bool owns(const Aabb& a, const Aabb& b) const;
+  /// Whether box b meets the region on `axis`: [lo, hi) meets [min, max] when min < hi and max >= lo.
+  bool meets(const Aabb& b, int axis) const { return b.min[axis] < hi[axis] && b.max[axis] >= lo[axis]; }
+};
+
+/// A slab: the ids of the boxes that meet it, and its region.
+using Slab = std::pair<std::vector<std::uint32_t>, Region>;
+
+/// Cuts boxes into slabs along an axis; keeps its buffers from one cut to the next.
+class SlabCutter {
+ public:
+  /// Cuts `outer` on `axis` into up to `parts` slabs at quantiles of the mins of `ids` (boxes of `boxes`):
+  /// their boxes, each in every slab it meets, and their regions.
+  std::vector<Slab> cut(std::span<const Aabb> boxes, std::span<const std::uint32_t> ids, const Region& outer, int axis,
+                        std::size_t parts);
+
+ private:
+  std::vector<double> mins_;         // the mins of the boxes on the axis
+  std::vector<std::uint16_t> bins_;  // their histogram bins
+};
+
+}  // namespace bpaccel
