@@ -22,13 +22,16 @@ bool Region::owns(const Aabb& a, const Aabb& b) const {
 namespace {
 
 // Four running minima and maxima: one pair would make each box wait for the last one's compare.
-std::pair<double, double> gatherMins(std::span<const Aabb> boxes, std::span<const std::uint32_t> ids, int axis,
-                                     std::vector<double>& mins) {
+std::pair<double, double> gatherEnds(std::span<const Aabb> boxes, std::span<const std::uint32_t> ids, int axis,
+                                     std::vector<double>& mins, std::vector<double>& maxes) {
   std::array<double, 4> least{HUGE_VAL, HUGE_VAL, HUGE_VAL, HUGE_VAL};
   std::array<double, 4> most{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  constexpr std::size_t kAhead = 16;  // the boxes of a slab lie scattered in a large scene: reads overlapped
   for (std::size_t k = 0; k < ids.size(); ++k) {
+    if (k + kAhead < ids.size()) __builtin_prefetch(&boxes[ids[k + kAhead]]);
     const double m = boxes[ids[k]].min[axis];
     mins[k] = m;
+    maxes[k] = boxes[ids[k]].max[axis];
     least[k % 4] = std::min(least[k % 4], m);
     most[k % 4] = std::max(most[k % 4], m);
   }
@@ -39,14 +42,15 @@ std::pair<double, double> gatherMins(std::span<const Aabb> boxes, std::span<cons
 
 std::vector<Slab> SlabCutter::cut(std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
                                   const Region& outer, int axis, std::size_t parts) {
-  // The mins gathered once, and each one's histogram bin kept: the passes after read them in order.
+  // The ends gathered once, and each min's histogram bin kept: the passes after read them in order.
   mins_.resize(ids.size());
-  const auto [least, most] = gatherMins(boxes, ids, axis, mins_);
+  maxes_.resize(ids.size());
+  const auto [least, most] = gatherEnds(boxes, ids, axis, mins_, maxes_);
   const Histogram bins{least, (most - least) / kBins};
   const std::vector<double> cuts = parts > 1 && most > least && std::isfinite(most - least)
                                        ? quantileCuts(bins, most, outer.lo[axis], outer.hi[axis], parts)
                                        : std::vector<double>{outer.lo[axis], outer.hi[axis]};
-  return assign(boxes, ids, outer, axis, cuts, bins);
+  return assign(ids, outer, axis, cuts, bins);
 }
 
 std::vector<double> SlabCutter::quantileCuts(const Histogram& bins, double most, double lo, double hi,
@@ -75,8 +79,7 @@ std::vector<double> SlabCutter::quantileCuts(const Histogram& bins, double most,
   return cuts;
 }
 
-std::vector<Slab> SlabCutter::assign(std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
-                                     const Region& outer, int axis, const std::vector<double>& cuts,
+std::vector<Slab> SlabCutter::assign(std::span<const std::uint32_t> ids, const Region& outer, int axis, const std::vector<double>& cuts,
                                      const Histogram& bins) {
   const std::size_t slabs = cuts.size() - 1;
   // Each box into every slab it meets, from the one holding its min (the last whose cut is at or below it,
@@ -102,7 +105,7 @@ std::vector<Slab> SlabCutter::assign(std::span<const Aabb> boxes, std::span<cons
     while (m < inner[k]) --k;
     while (m >= inner[k + 1]) ++k;
     // Region::meets, slab by slab: the first needs both ends checked, each next one only the max.
-    const double max = boxes[ids[j]].max[axis];
+    const double max = maxes_[j];
     std::size_t end = k;
     if (m < cuts[k + 1] && max >= cuts[k]) {
       end = k + 1;

@@ -48,10 +48,11 @@ class SlabCutter {
   /// outer's ends on the axis (lo, hi) and the cuts between, from the mins' histogram; fills bins_.
   std::vector<double> quantileCuts(const Histogram& bins, double most, double lo, double hi, std::size_t parts);
   /// The boxes, each into every slab between `cuts` it meets.
-  std::vector<Slab> assign(std::span<const Aabb> boxes, std::span<const std::uint32_t> ids, const Region& outer,
-                           int axis, const std::vector<double>& cuts, const Histogram& bins);
+  std::vector<Slab> assign(std::span<const std::uint32_t> ids, const Region& outer, int axis,
+                           const std::vector<double>& cuts, const Histogram& bins);
 
   std::vector<double> mins_;         // the mins of the boxes on the axis
+  std::vector<double> maxes_;        // and their maxes
   std::vector<std::uint16_t> bins_;  // their histogram bins
   std::vector<std::pair<std::uint16_t, std::uint16_t>> spans_;  // the slabs each box meets, [first, end)
 };
