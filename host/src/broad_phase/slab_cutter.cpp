@@ -60,7 +60,8 @@ std::vector<double> SlabCutter::quantileCuts(const Histogram& bins, double most,
   bins_.resize(mins_.size());
   std::array<std::uint32_t, kBins + 1> count{};
   for (std::size_t k = 0; k < mins_.size(); ++k) {
-    const auto bin = static_cast<std::uint16_t>(std::min(kBins, static_cast<std::size_t>((mins_[k] - bins.least) / bins.width)));
+    const auto bin =
+        static_cast<std::uint16_t>(std::min(kBins, static_cast<std::size_t>((mins_[k] - bins.least) / bins.width)));
     bins_[k] = bin;
     count[bin] += 1;
   }
@@ -79,8 +80,8 @@ std::vector<double> SlabCutter::quantileCuts(const Histogram& bins, double most,
   return cuts;
 }
 
-std::vector<Slab> SlabCutter::assign(std::span<const std::uint32_t> ids, const Region& outer, int axis, const std::vector<double>& cuts,
-                                     const Histogram& bins) {
+std::vector<Slab> SlabCutter::assign(std::span<const std::uint32_t> ids, const Region& outer, int axis,
+                                     const std::vector<double>& cuts, const Histogram& bins) {
   const std::size_t slabs = cuts.size() - 1;
   // Each box into every slab it meets, from the one holding its min (the last whose cut is at or below it,
   // or the first) on. A bin's slab is a guess that the comparisons with the cuts then make exact: no
@@ -104,7 +105,8 @@ std::vector<Slab> SlabCutter::assign(std::span<const std::uint32_t> ids, const R
     std::size_t k = slabs > 1 ? guess[bins_[j]] : 0;
     while (m < inner[k]) --k;
     while (m >= inner[k + 1]) ++k;
-    // Region::meets, slab by slab: the first needs both ends checked, each next one only the max.
+    // A box meets slab [lo, hi) when min < hi and max >= lo: the first slab needs both ends checked,
+    // each next one only the max.
     const double max = maxes_[j];
     std::size_t end = k;
     if (m < cuts[k + 1] && max >= cuts[k]) {

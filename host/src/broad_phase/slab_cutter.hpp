@@ -23,8 +23,6 @@ struct Region {
   bool bounded() const;
   /// Whether the region owns the pair of overlapping boxes a, b.
   bool owns(const Aabb& a, const Aabb& b) const;
-  /// Whether box b meets the region on `axis`: [lo, hi) meets [min, max] when min < hi and max >= lo.
-  bool meets(const Aabb& b, int axis) const { return b.min[axis] < hi[axis] && b.max[axis] >= lo[axis]; }
 };
 
 /// A slab: the ids of the boxes that meet it, and its region.
