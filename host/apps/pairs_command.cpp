@@ -65,6 +65,10 @@ void printStats(const PairsOptions& o, const BroadPhase& phase, std::size_t obje
              choice.cellSize ? std::string(phase.partition().name()) : "none", autoKind ? " (auto)" : "", objects,
              pairs, s.runs, s.batches, s.cycles, s.issueCycles, s.stallCycles, s.hits, s.boxesSent, s.beatsReceived,
              median(t.convert), median(t.partition), median(t.cells), median(t.total), median(t.host), o.repeat);
+  if (!choice.cellSize) return;
+  const CellOccupancy c = occupancyOf(phase.partition(), objects);
+  fmt::print(stderr, "cells {} entries {} entries-per-box {:.3f} mean-cell {:.1f}\n", c.cells, c.entries,
+             c.entriesPerBox(), c.meanCell());
 }
 
 std::unique_ptr<BroadPhase> makeBroadPhase(const PairsOptions& o, const BroadPhaseConfig& config,

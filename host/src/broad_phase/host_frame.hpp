@@ -63,7 +63,7 @@ class HostFrame {
   ThreadPool pool_;
   std::unique_ptr<Partition> tree_, grid_;
   Partition* used_;
-  AutomaticChoice chooser_;
+  AutomaticChoice chooser_{SizeRule::MeanCellBand};  // the kernel sets the best cell size
   CellChoice choice_;
   std::vector<KeyBox> keys_;
   std::vector<Local> locals_;  // one per thread

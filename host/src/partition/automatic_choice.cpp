@@ -23,7 +23,19 @@ CellOccupancy occupancyOf(const Partition& partition, std::size_t objects) {
 CellChoice AutomaticChoice::choose(std::size_t objects, const KeyBounds& /*bounds*/, PartitionKind kind) {
   if (kind == PartitionKind::Automatic && objects <= kOneCellUpTo) return {PartitionKind::UniformGrid, std::nullopt};
   const PartitionKind k = kind == PartitionKind::Automatic ? PartitionKind::UniformGrid : kind;
-  return {k, kFirstCellSize};
+  std::size_t size = kFirstCellSize;
+  // Only what this kind's cells told of the scene counts; a frame of one cell tells nothing.
+  if (rule_ == SizeRule::MeanCellBand && last_ && last_->kind == k && last_->cellSize)
+    size = nextCellSize(*last_->cellSize, lastOccupancy_);
+  return {k, size};
+}
+
+std::size_t AutomaticChoice::nextCellSize(std::size_t size, const CellOccupancy& occupancy) {
+  if (occupancy.fellBack || occupancy.entries == 0) return size;
+  const double mean = occupancy.meanCell();
+  if (mean > kMeanCellHigh && size / 2 >= kSmallestCellSize) return size / 2;
+  if (mean < kMeanCellLow && size * 2 <= kLargestCellSize) return size * 2;
+  return size;
 }
 
 void AutomaticChoice::observe(const CellChoice& used, const CellOccupancy& occupancy) {

@@ -38,14 +38,37 @@ struct CellOccupancy {
 /// The occupancy of a partition's last build.
 CellOccupancy occupancyOf(const Partition& partition, std::size_t objects);
 
+/// How the automatic cell size follows the scene.
+enum class SizeRule {
+  /// kFirstCellSize every frame: the device backends, whose lanes the cells fill.
+  Fixed,
+  /// From kFirstCellSize, halved or doubled each frame to keep the last
+  /// frame's box-weighted mean cell within [kMeanCellLow, kMeanCellHigh]:
+  /// the cpu backend, whose kernel is fastest on cells of tens of boxes.
+  MeanCellBand,
+};
+
 /// The rule (docs/host.md, "The automatic choice"). Keeps what it learnt of
 /// the scene from one frame to the next; one per broad phase.
 class AutomaticChoice {
  public:
   /// Scenes up to this many boxes are one cell.
   static constexpr std::size_t kOneCellUpTo = 96;
-  /// The grid's cell size at the first frame of a scene.
+  /// The cell size at the first frame of a scene (and every frame, SizeRule::Fixed).
   static constexpr std::size_t kFirstCellSize = 64;
+  /// SizeRule::MeanCellBand's limits. Above kMeanCellHigh too many cells
+  /// reach the kernel's sweep (AllPairsKernel::kSweepAbove boxes), which
+  /// costs more a box than all pairs below it; under kMeanCellLow the
+  /// entries (a box in each cell it touches) and the cells' fixed costs
+  /// outweigh the tests saved. Doubling a cell size less than doubles the
+  /// mean cell, so the band is over twice as wide as the step and a size
+  /// never swings between two.
+  static constexpr double kMeanCellLow = 28;
+  static constexpr double kMeanCellHigh = 64;
+  static constexpr std::size_t kSmallestCellSize = 16;
+  static constexpr std::size_t kLargestCellSize = 512;
+
+  explicit AutomaticChoice(SizeRule rule = SizeRule::Fixed) : rule_(rule) {}
 
   /// This frame's choice for `objects` boxes within `bounds`; `kind`
   /// Automatic lets the rule choose the kind too, else only the cell size.
@@ -54,6 +77,10 @@ class AutomaticChoice {
   void observe(const CellChoice& used, const CellOccupancy& occupancy);
 
  private:
+  // The next cell size after `size` gave cells of `occupancy`.
+  static std::size_t nextCellSize(std::size_t size, const CellOccupancy& occupancy);
+
+  SizeRule rule_;
   std::optional<CellChoice> last_;
   CellOccupancy lastOccupancy_;
 };

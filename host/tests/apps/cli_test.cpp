@@ -126,6 +126,10 @@ TEST(Cli, TheDefaultIsTheCpuBackendWithItsOwnPartitionOnEveryCore) {
                                         R"(\(auto\) objects 3000 )",
                                         hardwareThreads()));
   EXPECT_TRUE(std::regex_search(r.err, fastPath)) << r.err;
+  // The cells it ran, which the next frame's choice of cell size reads.
+  EXPECT_TRUE(std::regex_search(r.err, std::regex(R"(\ncells [1-9][0-9]* entries [1-9][0-9]* entries-per-box [0-9.]+ )"
+                                                  R"(mean-cell [0-9.]+\n)")))
+      << r.err;
 }
 
 TEST(Cli, TheHardwareBackendsAreOneOptionAwayOnOneDevice) {

@@ -156,3 +156,23 @@ TEST(CpuBackend, TheAutomaticChoiceIsExactOnEveryFamilyOnOneAndTwoThreads) {
         }
     }
 }
+
+TEST(CpuBackend, TheAutomaticCellSizeSettlesWithItsMeanCellInTheBandOnEveryFamily) {
+  std::size_t smallest = AutomaticChoice::kLargestCellSize, largest = 0;
+  for (SceneFamily f : allSceneFamilies()) {
+    BroadPhase bp([] { return std::make_unique<CpuBackend>(); }, {});
+    std::vector<Pair> pairs;
+    const auto scene = frames(f, 8000, 5, 6);
+    for (const auto& boxes : scene) bp.findPairs(boxes, pairs);
+    const std::size_t size = *bp.choice().cellSize;
+    const double mean = occupancyOf(bp.partition(), scene.back().size()).meanCell();
+    const bool inBand = mean >= AutomaticChoice::kMeanCellLow && mean <= AutomaticChoice::kMeanCellHigh;
+    const bool atALimit = (size == AutomaticChoice::kSmallestCellSize && mean > AutomaticChoice::kMeanCellHigh) ||
+                          (size == AutomaticChoice::kLargestCellSize && mean < AutomaticChoice::kMeanCellLow);
+    EXPECT_TRUE(inBand || atALimit) << familyName(f) << ": cell size " << size << ", mean cell " << mean;
+    smallest = std::min(smallest, size);
+    largest = std::max(largest, size);
+  }
+  // The families' densities differ enough that one size cannot suit them all.
+  EXPECT_LT(smallest, largest);
+}
