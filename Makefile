@@ -143,13 +143,14 @@ bench-run: host
 # The scene families unlike the bench's cube (docs/results.md, "Scene
 # families"): size variance, clusters, a flat world, long thin boxes, a layer
 # at one height. The software only (the cpu backend's rows against Bullet and
-# the peers), every frame validated. `make bench` runs each at 8000 objects
+# the peers; the fixed grid rows at the sizes the automatic choice moves
+# between), every frame validated. `make bench` runs each at 8000 objects
 # into results/families; this target at 1000, 8000 and 100,000 into
 # results/families-all.
 BENCH_FAMILIES         ?= sizes clusters flat poles layer
 BENCH_FAMILIES_OBJECTS ?= 1000 8000 100000
 BENCH_FAMILIES_DIR     ?= results/families-all
-BENCH_FAMILIES_ARGS    ?= --frames 10 --warmup 2 --no-accelerator --whole-step-objects 0 --many-worlds 0 --query-objects none
+BENCH_FAMILIES_ARGS    ?= --frames 10 --warmup 2 --no-accelerator --grid-cell-sizes 16 32 64 128 256 --whole-step-objects 0 --many-worlds 0 --query-objects none
 .PHONY: bench-families bench-families-run
 bench-families: deps
 	$(MAKE) bench-families-run ARCH=$(BENCH_ARCH) M=$(BENCH_M) HOST_BIN_DIR=$(BENCH_BIN_DIR)
