@@ -1,7 +1,8 @@
 # Initial cache (cmake -C) for the sanitizer build of the host: the library,
-# the Verilated model, the CLI and every test under AddressSanitizer and
-# UndefinedBehaviorSanitizer. Any report aborts (no recovery), so a finding
-# fails its test. libstdc++'s assertions add bounds checks to operator[].
+# the Verilated models' transports, the CLI and every test under
+# AddressSanitizer and UndefinedBehaviorSanitizer (Verilator's own C++:
+# below). Any report aborts (no recovery), so a finding fails its test.
+# libstdc++'s assertions add bounds checks to operator[].
 # -O1 keeps the build and the slow Verilated tests affordable; no NDEBUG.
 # -g1 (line tables) is what a report's stack trace reads, at two thirds of
 # -g's compile time.
