@@ -178,13 +178,10 @@ bench-large-run: host
 HOST_SANITIZE_BUILD := build/host-asan-$(DESIGN_NAME)
 SANITIZER_ENV := ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1:strict_init_order=1 \
                  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-# What the tests run (host_tests runs the CLIs); the benchmark's timing tools
-# (frame_timing, binning_frame) are built, without sanitizers, by make test.
-HOST_SANITIZE_TARGETS := host_tests keys_fast_math_test
 host-sanitize: deps $(HOST_GENERATED)
 	cmake -S host -B $(HOST_SANITIZE_BUILD) -G Ninja -C host/cmake/sanitize.cmake \
 	  $(HOST_GENERATED_DIRS) -DBPACCEL_BIN_DIR=$(abspath $(HOST_SANITIZE_BUILD))/bin
-	cmake --build $(HOST_SANITIZE_BUILD) -j 2 --target $(HOST_SANITIZE_TARGETS)
+	cmake --build $(HOST_SANITIZE_BUILD) -j 2
 
 # CI runs it after `make test` (.ci/run): its build and run take about as long
 # as the rest of the host's tests together. The packaging test is left to

@@ -15,10 +15,10 @@
 #include "peers/bullet_methods.hpp"
 #include "bullet/bullet_drop_in.hpp"
 #include "core/median.hpp"
-#include "step_timing.hpp"
+#include "scenes/step_timing.hpp"
 
 #include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
-#include "exact_pairs.hpp"
+#include "scenes/exact_pairs.hpp"
 #include "peers/cgal/cgal_box_intersection.hpp"
 #include "peers/fcl_managers.hpp"
 #include "peers/ode_spaces.hpp"

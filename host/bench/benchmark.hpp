@@ -15,8 +15,8 @@
 #include "many_worlds_bench.hpp"
 #include "methods/binning_method.hpp"
 #include "query_bench.hpp"
-#include "scene.hpp"
-#include "scene_families.hpp"
+#include "scenes/scene.hpp"
+#include "scenes/scene_families.hpp"
 #include "methods/timed_method.hpp"
 #include "core/types.hpp"
 

@@ -14,11 +14,11 @@
 #include "broad_phase/many_worlds.hpp"
 #include "core/median.hpp"
 #include "device/cpu_backend.hpp"
-#include "exact_pairs.hpp"
+#include "scenes/exact_pairs.hpp"
 #include "model/link_model.hpp"
 #include "peers/bullet_methods.hpp"
 #include "peers/fcl_managers.hpp"
-#include "scene_families.hpp"
+#include "scenes/scene_families.hpp"
 
 namespace bpaccel {
 namespace {

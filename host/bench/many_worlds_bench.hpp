@@ -19,7 +19,7 @@
 #include "core/types.hpp"
 #include "methods/accelerator_method.hpp"
 #include "model/device_profile.hpp"
-#include "scene.hpp"
+#include "scenes/scene.hpp"
 
 namespace bpaccel {
 

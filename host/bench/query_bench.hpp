@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "scene.hpp"
+#include "scenes/scene.hpp"
 
 namespace bpaccel {
 

@@ -15,3 +15,6 @@ set(CMAKE_EXE_LINKER_FLAGS_SANITIZE "-fsanitize=address,undefined,float-cast-ove
 # without the sanitizers (cmake/verilated_model.cmake), the Verilated tests run
 # several times faster; the transport and driver around them stay checked.
 set(BPACCEL_VERILATED_COMPILE_OPTIONS "-fno-sanitize=all" CACHE STRING "")
+# The library and its program only: the benchmark, which no engine links,
+# and its tests run unsanitized in make test.
+set(BPACCEL_BENCH OFF CACHE BOOL "" FORCE)

@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "scenes/exact_pairs.hpp"
+
 namespace bpaccel {
 
 std::string_view kindName(MethodKind kind) {
@@ -27,21 +29,6 @@ SkipRule allPairsSkipReason(double maxTestsPerFrame) {
     return fmt::format("tests all pairs: {:.2g} tests a frame, above the limit of {:.2g} (--max-all-pairs-tests)",
                        tests, maxTestsPerFrame);
   };
-}
-
-std::uint64_t pairsOverlappingOn(std::span<const Aabb> boxes, int axis) {
-  std::vector<std::pair<float, float>> xs(boxes.size());  // (min, max) on the axis, sorted by min
-  std::transform(boxes.begin(), boxes.end(), xs.begin(),
-                 [axis](const Aabb& b) { return std::pair(b.min[axis], b.max[axis]); });
-  std::ranges::sort(xs, {}, &std::pair<float, float>::first);
-  // Each pair once: counted at the box that comes first in order of min,
-  // against every later box whose min is not beyond its max.
-  std::uint64_t pairs = 0;
-  for (auto it = xs.begin(); it != xs.end(); ++it) {
-    const auto end = std::ranges::upper_bound(it + 1, xs.end(), it->second, {}, &std::pair<float, float>::first);
-    pairs += static_cast<std::uint64_t>(end - it - 1);
-  }
-  return pairs;
 }
 
 SkipRule sweepSkipReason(double maxTests) {

@@ -102,12 +102,6 @@ using SkipRule = std::function<std::optional<std::string>(const SceneStart&)>;
 /// are skipped where that exceeds `maxTestsPerFrame`.
 SkipRule allPairsSkipReason(double maxTestsPerFrame);
 
-/// The number of pairs of boxes whose intervals on `axis` overlap (closed):
-/// the interval tests of a sort-and-sweep along that axis. O(n log n).
-std::uint64_t pairsOverlappingOn(std::span<const Aabb> boxes, int axis);
-/// The same along x.
-inline std::uint64_t pairsOverlappingOnX(std::span<const Aabb> boxes) { return pairsOverlappingOn(boxes, 0); }
-
 /// The skip rule of a sort-and-sweep along x that cannot be interrupted (set-up
 /// or rebuild): skipped where the scene's pairsOverlappingOnX exceeds `maxTests`.
 SkipRule sweepSkipReason(double maxTests);

@@ -1,5 +1,5 @@
 #include "bullet_methods.hpp"
-#include "bullet_pairs.hpp"
+#include "scenes/bullet_pairs.hpp"
 
 #include <algorithm>
 #include <cstdint>

@@ -17,11 +17,11 @@
 #include <fmt/format.h>
 
 #include "core/median.hpp"
-#include "exact_pairs.hpp"
+#include "scenes/exact_pairs.hpp"
 #include "methods/binning_method.hpp"
 #include "model/device_profile.hpp"
 #include "model/fpga_report.hpp"
-#include "scene.hpp"
+#include "scenes/scene.hpp"
 
 namespace {
 

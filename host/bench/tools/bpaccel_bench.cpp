@@ -23,8 +23,8 @@
 
 #include "device/backend.hpp"
 #include "benchmark.hpp"
-#include "scene.hpp"
-#include "scene_families.hpp"
+#include "scenes/scene.hpp"
+#include "scenes/scene_families.hpp"
 #include "core/box_file.hpp"
 #include "bpaccel_params.h"
 #include "broad_phase/broad_phase.hpp"

@@ -48,11 +48,11 @@
 #include "device/backend.hpp"
 #include "broad_phase/broad_phase.hpp"
 #include "core/median.hpp"
-#include "exact_pairs.hpp"
+#include "scenes/exact_pairs.hpp"
 #include "model/device_profile.hpp"
 #include "model/paced_backend.hpp"
 #include "device/rtl/rtl_backend.hpp"
-#include "scene.hpp"
+#include "scenes/scene.hpp"
 #include "model/timeline.hpp"
 
 // Heap allocations, counted to report those a frame makes (a frame should

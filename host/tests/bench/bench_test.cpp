@@ -19,13 +19,13 @@
 #include "rtl_device.hpp"
 #include "bpaccel_params.h"
 #include "peers/bullet_methods.hpp"
-#include "exact_pairs.hpp"
+#include "scenes/exact_pairs.hpp"
 #include "peers/fcl_managers.hpp"
 #include "peers/ode_spaces.hpp"
 #include "device/rtl/rtl_backend.hpp"
-#include "scene.hpp"
+#include "scenes/scene.hpp"
 #include "scenes.hpp"
-#include "step_timing.hpp"
+#include "scenes/step_timing.hpp"
 
 #include <BulletCollision/BroadphaseCollision/btDbvtBroadphase.h>
 

@@ -19,7 +19,7 @@
 #include "device/built_device.hpp"
 #include "device/cpu_backend.hpp"
 #include "device/model_backend.hpp"
-#include "exact_pairs.hpp"
+#include "scenes/exact_pairs.hpp"
 #include "partition/kd_tree.hpp"
 #include "scenes.hpp"
 

@@ -24,8 +24,8 @@
 #include "bullet/bullet_drop_in.hpp"
 #include "device/rtl/rtl_backend.hpp"
 #include "dropping_backend.hpp"
-#include "scene.hpp"
-#include "step_timing.hpp"
+#include "scenes/scene.hpp"
+#include "scenes/step_timing.hpp"
 
 namespace {
 

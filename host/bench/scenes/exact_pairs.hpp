@@ -2,6 +2,7 @@
 // The exact overlap set on the floats: the benchmark's reference,
 // independent of the k-d tree, the keys and the backends.
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -21,5 +22,11 @@ void exactPairs(std::span<const Aabb> boxes, std::vector<Pair>& out);
 
 /// The same set by sort and sweep on `axis`: O(n log n + boxes overlapping on that axis).
 void sortAndSweepPairs(std::span<const Aabb> boxes, std::vector<Pair>& out, int axis = 0);
+
+/// The number of pairs of boxes whose intervals on `axis` overlap (closed):
+/// the interval tests of a sort-and-sweep along that axis. O(n log n).
+std::uint64_t pairsOverlappingOn(std::span<const Aabb> boxes, int axis);
+/// The same along x.
+inline std::uint64_t pairsOverlappingOnX(std::span<const Aabb> boxes) { return pairsOverlappingOn(boxes, 0); }
 
 }  // namespace bpaccel

@@ -7,7 +7,7 @@
 #include <btBulletDynamicsCommon.h>
 #include <fmt/format.h>
 
-#include "peers/bullet_pairs.hpp"
+#include "bullet_pairs.hpp"
 
 namespace bpaccel {
 

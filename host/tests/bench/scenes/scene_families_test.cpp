@@ -7,8 +7,8 @@
 
 #include "broad_phase/broad_phase.hpp"
 #include "device/cpu_backend.hpp"
-#include "exact_pairs.hpp"
-#include "scene_families.hpp"
+#include "scenes/exact_pairs.hpp"
+#include "scenes/scene_families.hpp"
 #include "scenes.hpp"
 
 using namespace bpaccel;

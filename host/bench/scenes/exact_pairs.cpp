@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <numeric>
 
-#include "methods/timed_method.hpp"
 
 namespace bpaccel {
 
@@ -143,6 +142,21 @@ void exactPairs(std::span<const Aabb> boxes, std::vector<Pair>& out) {
   if (sweepTests < grid.tests()) return sortAndSweepPairs(boxes, out, axis);
   grid.pairs(out);
   std::sort(out.begin(), out.end());
+}
+
+std::uint64_t pairsOverlappingOn(std::span<const Aabb> boxes, int axis) {
+  std::vector<std::pair<float, float>> xs(boxes.size());  // (min, max) on the axis, sorted by min
+  std::transform(boxes.begin(), boxes.end(), xs.begin(),
+                 [axis](const Aabb& b) { return std::pair(b.min[axis], b.max[axis]); });
+  std::ranges::sort(xs, {}, &std::pair<float, float>::first);
+  // Each pair once: counted at the box that comes first in order of min,
+  // against every later box whose min is not beyond its max.
+  std::uint64_t pairs = 0;
+  for (auto it = xs.begin(); it != xs.end(); ++it) {
+    const auto end = std::ranges::upper_bound(it + 1, xs.end(), it->second, {}, &std::pair<float, float>::first);
+    pairs += static_cast<std::uint64_t>(end - it - 1);
+  }
+  return pairs;
 }
 
 }  // namespace bpaccel
