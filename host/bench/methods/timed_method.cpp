@@ -1,8 +1,5 @@
 #include "timed_method.hpp"
 
-#include <algorithm>
-#include <utility>
-
 #include <fmt/format.h>
 
 #include "scenes/exact_pairs.hpp"

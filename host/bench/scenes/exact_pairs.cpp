@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
-
+#include <utility>
 
 namespace bpaccel {
 

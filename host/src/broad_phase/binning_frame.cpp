@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "../core/keys.hpp"
+#include "gather.hpp"
 
 namespace bpaccel {
 namespace {
@@ -160,12 +161,11 @@ void BinningFrame::send() {
 
 void BinningFrame::decode(const PlannedFrame& f, const FrameReply& r, std::vector<Pair>& out) {
   const bool bounded = f.region.bounded();
-  // The pairs come in the device's order, so the boxes are read at random: each read is asked for a few pairs ahead.
-  constexpr std::size_t kAhead = 16;
+  // The pairs come in the device's order, so the boxes are read at random: each read is asked for ahead.
   const std::size_t n = f.ids.size();
   for (std::size_t k = 0; k < r.pairs.size(); ++k) {
-    if (k + kAhead < r.pairs.size()) {
-      const auto [pi, pj] = r.pairs[k + kAhead];
+    if (k + kGatherAhead < r.pairs.size()) {
+      const auto [pi, pj] = r.pairs[k + kGatherAhead];
       if (pi < n && pj < n) __builtin_prefetch(&boxes_[f.ids[pi]]), __builtin_prefetch(&boxes_[f.ids[pj]]);
     }
     const auto [li, lj] = r.pairs[k];

@@ -11,6 +11,7 @@
 
 #include "../core/cpu_features.hpp"
 #include "../core/keys.hpp"
+#include "gather.hpp"
 
 namespace bpaccel {
 
@@ -196,12 +197,9 @@ KeyGrid gridFor(const BinningParams& p, const AxisBounds& bounds, const std::arr
 
 KeyGrid pickGrid(const BinningParams& p, std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
                  const std::array<double, 3>& cellEdge) {
-  // A region's boxes lie scattered in a large scene: each is asked for some boxes ahead, so the reads
-  // overlap (at 1,000,000 boxes each would otherwise wait for memory).
-  constexpr std::size_t kAhead = 16;
   AxisBounds bounds;
   for (std::size_t k = 0; k < ids.size(); ++k) {
-    if (k + kAhead < ids.size()) __builtin_prefetch(&boxes[ids[k + kAhead]]);
+    prefetchAhead(boxes, ids, k);
     bounds.add(boxes[ids[k]]);
   }
   return gridFor(p, bounds, cellEdge);

@@ -78,7 +78,7 @@ void HostFrame::findKeyPairs(std::span<const KeyBox> keys, const KeyBounds* give
   if (choice_.cellSize) {
     runCells(keys);
   } else {
-    if (config_.cellSize.isAutomatic()) chooser_.observe(choice_, {keys.size(), keys.size(), 0, 1, false});
+    if (config_.cellSize.isAutomatic()) chooser_.observe(choice_, {keys.size(), keys.size(), 0, 1});
     Local& l = locals_.front();
     kernel_.ownedPairs({keys, {}, {}}, l.pairs, l.scratch);
     l.stats.runs = l.stats.batches = keys.size() >= 2;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <limits>
 
+#include "gather.hpp"
+
 namespace bpaccel {
 
 bool Region::bounded() const {
@@ -26,9 +28,8 @@ std::pair<double, double> gatherEnds(std::span<const Aabb> boxes, std::span<cons
                                      std::vector<double>& mins, std::vector<double>& maxes) {
   std::array<double, 4> least{HUGE_VAL, HUGE_VAL, HUGE_VAL, HUGE_VAL};
   std::array<double, 4> most{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  constexpr std::size_t kAhead = 16;  // the boxes of a slab lie scattered in a large scene: reads overlapped
   for (std::size_t k = 0; k < ids.size(); ++k) {
-    if (k + kAhead < ids.size()) __builtin_prefetch(&boxes[ids[k + kAhead]]);
+    prefetchAhead(boxes, ids, k);
     const double m = boxes[ids[k]].min[axis];
     mins[k] = m;
     maxes[k] = boxes[ids[k]].max[axis];

@@ -31,7 +31,7 @@ CellChoice AutomaticChoice::choose(std::size_t objects, const KeyBounds& /*bound
 }
 
 std::size_t AutomaticChoice::nextCellSize(std::size_t size, const CellOccupancy& occupancy) {
-  if (occupancy.fellBack || occupancy.entries == 0) return size;
+  if (occupancy.entries == 0) return size;
   const double mean = occupancy.meanCell();
   if (mean > kMeanCellHigh && size / 2 >= kSmallestCellSize) return size / 2;
   if (mean < kMeanCellLow && size * 2 <= kLargestCellSize) return size * 2;

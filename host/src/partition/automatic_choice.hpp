@@ -28,7 +28,6 @@ struct CellOccupancy {
   std::uint64_t entries = 0;      // sum of the cells' box counts
   std::uint64_t squares = 0;      // sum of the squares of the cells' box counts
   std::uint64_t cells = 0;        // cells with at least one box
-  bool fellBack = false;          // the grid handed the frame to the k-d tree
   /// The box-weighted mean cell: the count of the cell an entry picked at random lies in.
   double meanCell() const { return entries ? static_cast<double>(squares) / static_cast<double>(entries) : 0; }
   /// Entries per box: how many cells a box touches, on average.

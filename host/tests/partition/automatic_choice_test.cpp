@@ -9,7 +9,7 @@ using namespace bpaccel;
 namespace {
 
 // The occupancy of cells whose box-weighted mean cell is `mean`: one cell of `mean` boxes.
-CellOccupancy meanCellOf(std::uint64_t mean) { return {mean, mean, mean * mean, 1, false}; }
+CellOccupancy meanCellOf(std::uint64_t mean) { return {mean, mean, mean * mean, 1}; }
 
 constexpr std::size_t kBoxes = 8000;
 const KeyBounds kBounds{};
