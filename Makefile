@@ -70,7 +70,7 @@ deps:
 
 # Every test of the project, part by part; the last line gives each part's
 # time against the 10-minute budget (scripts/test_parts.sh). The fuzz targets
-# are built beside sbt's start, which leaves a core idle.
+# are built at low priority from the start, in the cores the parts leave idle.
 test: deps
 	@MAKE="$(MAKE)" scripts/test_parts.sh --ahead fuzz sbt=test-hw host=test-host fpga=test-fpga fuzz=test-fuzz
 

