@@ -19,14 +19,18 @@ if [ "${1:-}" = "--ahead" ]; then ahead=$2; shift 2; fi
 
 start=$SECONDS
 ahead_pid=
-# The ahead build runs in a session of its own (so it can be ended with its
-# children): a run that stops early, or is interrupted, ends it here.
+# The ahead build runs in a process group of its own (so it can be ended with
+# its children): a run that stops early, or is interrupted, ends it here. Not
+# a session of its own: the kernel's autogroup scheduling would share the
+# cores between the two sessions, and its nice would count for nothing.
 stop_ahead() { [ -n "$ahead_pid" ] && kill -- "-$ahead_pid" 2>/dev/null; ahead_pid=; }
 trap stop_ahead EXIT
 if [ -n "$ahead" ]; then
   mkdir -p build
-  setsid nice -n 19 "$make_cmd" --no-print-directory "$ahead" >"build/ahead-$ahead.log" 2>&1 &
+  set -m  # job control: the background job leads a process group
+  nice -n 19 "$make_cmd" --no-print-directory "$ahead" >"build/ahead-$ahead.log" 2>&1 &
   ahead_pid=$!
+  set +m
 fi
 parts=()
 failed=
