@@ -59,6 +59,7 @@ int main(int argc, char** argv) {
   std::vector<Row> rows(methods.size());
   std::vector<double> cycles;
   bpaccel::FramePhases phases;
+  std::size_t onePassFrames = 0;
   for (std::size_t f = 0; f < frames; ++f) {
     scene.step();
     scene.aabbs(boxes);
@@ -85,6 +86,7 @@ int main(int argc, char** argv) {
     const auto& s = methods[0]->stats();
     cycles.push_back(static_cast<double>(s.deviceCycles));
     phases = s.phases;
+    onePassFrames += s.onePass;
   }
   const auto& s = methods[0]->stats();
   const auto& planned = methods[0]->frame().frames();
@@ -97,6 +99,7 @@ int main(int argc, char** argv) {
              "phases intake {} prefix {} sort {} compute {} drain {}, {} device pairs ({} false from quantization)\n",
              s.frames + s.retries, s.retries, s.boxesSent, s.hostBoxes, dims[0], dims[1], dims[2], phases.intake, phases.prefix, phases.sort,
              phases.compute, phases.drain, s.devicePairs, s.falsePositives);
+  fmt::print("the last frame's grid kept, the survey and keys in one pass: {} of {} frames\n", onePassFrames, frames);
   for (std::size_t k = 0; k < methods.size(); ++k) {
     const double host = bpaccel::median(rows[k].host), dev = bpaccel::median(rows[k].device),
                  link = bpaccel::median(rows[k].link);

@@ -25,7 +25,9 @@ void BinningFrame::findPairs(std::span<const Aabb> boxes, std::vector<Pair>& out
 
 void BinningFrame::plan(std::span<const Aabb> boxes) {
   const BinningParams& p = device_.params();
-  const ExtentSurvey survey = surveyExtents(p, boxes);  // checks the boxes
+  // A scene of one device frame tries the last frame's grid first: one pass then surveys and writes the keys.
+  const auto steady = boxes.size() <= p.boxCapacity ? steady_.survey(p, boxes, steadyKeys_) : std::nullopt;
+  const ExtentSurvey survey = steady ? steady->survey : surveyExtents(p, boxes);  // checks the boxes
   boxes_ = boxes;
   stats_ = {};
   for (PlannedFrame& f : frames_) spare_.push_back(std::move(f));  // their buffers, for this frame's
@@ -36,6 +38,17 @@ void BinningFrame::plan(std::span<const Aabb> boxes) {
   isLong_.assign(boxes.size(), 0);
   cellEdge_ = survey.cellEdge;
   PlannedFrame whole = takeSpare();
+  if (steady) {  // every box within the cell edge: one frame
+    whole.ids.resize(boxes.size());
+    std::iota(whole.ids.begin(), whole.ids.end(), 0u);
+    whole.grid = steady->grid;
+    whole.region = Region{};
+    if (steady->keysDone) std::swap(whole.keys, steadyKeys_), stats_.onePass = true;
+    frames_.push_back(std::move(whole));
+    if (!steady->keysDone) fillKeys(frames_.back());
+    steady_.keep(frames_.back().grid, survey);
+    return;
+  }
   AxisBounds bounds = survey.bounds;
   if (survey.allWithin) {
     whole.ids.resize(boxes.size());
@@ -48,8 +61,11 @@ void BinningFrame::plan(std::span<const Aabb> boxes) {
     whole.region = Region{};
     frames_.push_back(std::move(whole));
     fillKeys(frames_.back());
+    if (survey.allWithin) steady_.keep(frames_.back().grid, survey);
+    else steady_.forget();
     return;
   }
+  steady_.forget();
   planRegions(whole.ids, bounds);
   spare_.push_back(std::move(whole));
 }

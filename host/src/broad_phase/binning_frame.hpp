@@ -12,6 +12,7 @@
 #include "../device/binning/frame_device.hpp"
 #include "binning_grid.hpp"
 #include "slab_cutter.hpp"
+#include "steady_grid.hpp"
 
 namespace bpaccel {
 
@@ -24,6 +25,7 @@ struct BinningFrameStats {
   std::size_t devicePairs = 0;     // pairs the device sent back
   std::size_t falsePositives = 0;  // of them, dropped by the float recheck (quantization)
   std::size_t boundaryDrops = 0;   // of them, owned by a neighbouring region
+  bool onePass = false;            // the survey wrote the keys, on the last frame's grid (SteadyGrid)
   std::uint64_t deviceCycles = 0;  // summed over the frames sent, refused ones too
   std::uint64_t issueCycles = 0;
   FramePhases phases;              // summed over the frames that returned pairs
@@ -68,6 +70,9 @@ class BinningFrame {
   void collect(std::vector<Pair>& out);
   const BinningFrameStats& stats() const { return stats_; }
   const std::vector<PlannedFrame>& frames() const { return frames_; }
+  /// The grid kept from frame to frame: a caller that runs one frame twice (the bench's recording pass, then
+  /// its timed one) puts it back between them, so that the second plans as the first did.
+  SteadyGrid& steadyGrid() { return steady_; }
 
  private:
   /// The boxes within the cell edge into `ids`, the others to the host's path; returns the bounds of `ids`.
@@ -97,6 +102,8 @@ class BinningFrame {
   std::vector<std::uint8_t> isLong_;
   std::vector<Pair> hostPairs_;  // of regions no cut could shrink
   SlabCutter cutter_;
+  SteadyGrid steady_;                  // the last common frame's grid, tried first
+  std::vector<KeyBox> steadyKeys_;     // its pass's keys, swapped into the frame when the grid serves
   BinningFrameStats stats_;
 };
 

@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #if defined(__x86_64__)
 #include <immintrin.h>
@@ -52,35 +53,50 @@ void briefScalar(std::span<const Aabb> boxes, std::size_t from, ExtentBrief& bri
 }
 
 #if defined(__x86_64__)
-// The brief's first pass four lanes at a time: a box's mins (and its max x) in one vector, its maxes (and
-// the next box's min x) in another, so lanes 0-2 are its axes; the last box is left to the scalar loop.
-__attribute__((target("avx2"))) std::size_t briefAvx2(std::span<const Aabb> boxes, ExtentBrief& brief) {
-  if (boxes.size() < 2) return 0;
-  const __m256d infinity = _mm256_set1_pd(HUGE_VAL), one = _mm256_set1_pd(1);
-  __m256d longest = _mm256_setzero_pd(), notFinite = _mm256_setzero_pd(), suspect = _mm256_setzero_pd();
-  __m256d lo = infinity, hi = _mm256_set1_pd(-HUGE_VAL);
-  const std::size_t last = boxes.size() - 1;
-  for (std::size_t i = 0; i < last; ++i) {
-    const __m256d mins = _mm256_cvtps_pd(_mm_loadu_ps(&boxes[i].min[0]));
-    const __m256d maxs = _mm256_cvtps_pd(_mm_loadu_ps(&boxes[i].max[0]));
+// The brief's accumulators, four lanes at a time: a box's mins (and its max x) in one vector, its maxes (and
+// the next box's min x) in another, so lanes 0-2 are its axes and lane 3 is ignored.
+struct BriefLanes {
+  __m256d longest, notFinite, suspect, lo, hi;
+
+  __attribute__((target("avx2"))) BriefLanes()
+      : longest(_mm256_setzero_pd()), notFinite(_mm256_setzero_pd()), suspect(_mm256_setzero_pd()),
+        lo(_mm256_set1_pd(HUGE_VAL)), hi(_mm256_set1_pd(-HUGE_VAL)) {}
+
+  /// Adds one box; returns its extents.
+  __attribute__((target("avx2"))) __m256d add(__m256d mins, __m256d maxs) {
     const __m256d e = _mm256_sub_pd(maxs, mins);
-    const __m256d finite = _mm256_cmp_pd(e, infinity, _CMP_LT_OQ);
+    const __m256d finite = _mm256_cmp_pd(e, _mm256_set1_pd(HUGE_VAL), _CMP_LT_OQ);
     longest = _mm256_max_pd(longest, _mm256_and_pd(finite, e));
-    notFinite = _mm256_add_pd(notFinite, _mm256_andnot_pd(finite, one));
+    notFinite = _mm256_add_pd(notFinite, _mm256_andnot_pd(finite, _mm256_set1_pd(1)));
     // A NaN, or a min above its max (an exact difference of floats is negative then), makes !(e >= 0);
     // so does +inf - +inf, a good box, which checkBoxes then passes.
     suspect = _mm256_or_pd(suspect, _mm256_cmp_pd(e, _mm256_setzero_pd(), _CMP_NGE_UQ));
     lo = _mm256_min_pd(lo, mins), hi = _mm256_max_pd(hi, maxs);
+    return e;
   }
-  brief.checked = (_mm256_movemask_pd(suspect) & 0b111) == 0;
-  alignas(32) std::array<double, 4> l, n, b0, b1;
-  _mm256_store_pd(l.data(), longest), _mm256_store_pd(n.data(), notFinite);
-  _mm256_store_pd(b0.data(), lo), _mm256_store_pd(b1.data(), hi);
-  for (int a = 0; a < 3; ++a) {
-    brief.longest[a] = std::max(brief.longest[a], l[a]);
-    brief.notFinite[a] += static_cast<std::size_t>(n[a]);
-    brief.bounds.lo[a] = std::min(brief.bounds.lo[a], b0[a]), brief.bounds.hi[a] = std::max(brief.bounds.hi[a], b1[a]);
+
+  /// Lanes 0-2 into `brief`, whose other boxes they join.
+  __attribute__((target("avx2"))) void addTo(ExtentBrief& brief) const {
+    brief.checked = (_mm256_movemask_pd(suspect) & 0b111) == 0;
+    alignas(32) std::array<double, 4> l, n, b0, b1;
+    _mm256_store_pd(l.data(), longest), _mm256_store_pd(n.data(), notFinite);
+    _mm256_store_pd(b0.data(), lo), _mm256_store_pd(b1.data(), hi);
+    for (int a = 0; a < 3; ++a) {
+      brief.longest[a] = std::max(brief.longest[a], l[a]);
+      brief.notFinite[a] += static_cast<std::size_t>(n[a]);
+      brief.bounds.lo[a] = std::min(brief.bounds.lo[a], b0[a]), brief.bounds.hi[a] = std::max(brief.bounds.hi[a], b1[a]);
+    }
   }
+};
+
+// The brief's first pass; the last box is left to the scalar loop.
+__attribute__((target("avx2"))) std::size_t briefAvx2(std::span<const Aabb> boxes, ExtentBrief& brief) {
+  if (boxes.size() < 2) return 0;
+  BriefLanes lanes;
+  const std::size_t last = boxes.size() - 1;
+  for (std::size_t i = 0; i < last; ++i)
+    lanes.add(_mm256_cvtps_pd(_mm_loadu_ps(&boxes[i].min[0])), _mm256_cvtps_pd(_mm_loadu_ps(&boxes[i].max[0])));
+  lanes.addTo(brief);
   return last;
 }
 
@@ -101,6 +117,71 @@ __attribute__((target("avx2"))) std::size_t topAvx2(std::span<const Aabb> boxes,
   _mm256_store_pd(t.data(), top);
   for (int a = 0; a < 3; ++a) brief.top[a] += static_cast<std::size_t>(t[a]);
   return last;
+}
+#endif
+
+/// The survey of a common frame (every extent finite, none an outlier) from its brief.
+ExtentSurvey commonSurvey(const BinningParams& p, const ExtentBrief& brief) {
+  const double keys = std::ldexp(1.0, static_cast<int>(p.maxShift()));
+  ExtentSurvey survey;
+  survey.bounds = brief.bounds;
+  survey.allWithin = true;
+  for (int a = 0; a < 3; ++a) {
+    // A box of e spans at most e / unit + 2 keys after the outward rounding; 2^s keys make a cell.
+    survey.cellEdge[a] = brief.longest[a] * keys / (keys - 4);
+    survey.topFloor[a] = topFloor(brief.longest[a]);
+  }
+  return survey;
+}
+
+/// Whether the brief of n boxes is a common frame's: every extent finite, and more than the outliers (n / 256)
+/// in the longest's top buckets, so the (outliers + 1)-th longest is there too and no extent is an outlier.
+bool isCommon(const ExtentBrief& brief, std::size_t n) {
+  bool common = true;
+  for (int a = 0; a < 3; ++a)
+    common = common && brief.notFinite[a] == 0 && brief.top[a] > n / 256 && topFloor(brief.longest[a]) > 0;
+  return common;
+}
+
+#if defined(__x86_64__)
+// briefAvx2, topAvx2 on a guessed floor and quantizeAvx2 on contiguous boxes, in one loop (the last box left to
+// the caller): returns whether every box's keys fit the cells. A box's keys are stored as two four-key vectors,
+// min x, y, z and max x, then max x, y, z and the next box's min x; each store's fourth key is overwritten by
+// the next one, so the stores stay within the keys for all but the last box.
+__attribute__((target("avx2"))) bool commonPassAvx2(const KeyGrid& g, const std::array<double, 3>& guessedFloor,
+                                                    std::span<const Aabb> boxes, ExtentBrief& brief,
+                                                    std::span<KeyBox> keys) {
+  const __m256d one = _mm256_set1_pd(1), zero = _mm256_setzero_pd();
+  const __m256d floor = _mm256_setr_pd(guessedFloor[0], guessedFloor[1], guessedFloor[2], HUGE_VAL);
+  const __m256d origin = _mm256_setr_pd(g.origin[0], g.origin[1], g.origin[2], g.origin[0]);
+  const __m256d scale = _mm256_setr_pd(g.scale[0], g.scale[1], g.scale[2], g.scale[0]);
+  const __m256d top = _mm256_setr_pd(g.top[0], g.top[1], g.top[2], g.top[0]);
+  const __m128i shift = _mm_cvtsi32_si128(static_cast<int>(g.shift)), oneKey = _mm_set1_epi32(1);
+  const __m128i axes = _mm_setr_epi32(-1, -1, -1, 0);
+  BriefLanes lanes;
+  __m256d count = zero;
+  __m128i wide = _mm_setzero_si128();
+  const std::size_t last = boxes.size() - 1;
+  for (std::size_t i = 0; i < last; ++i) {
+    const __m256d mins = _mm256_cvtps_pd(_mm_loadu_ps(&boxes[i].min[0]));
+    const __m256d maxs = _mm256_cvtps_pd(_mm_loadu_ps(&boxes[i].max[0]));
+    const __m256d e = lanes.add(mins, maxs);
+    count = _mm256_add_pd(count, _mm256_and_pd(_mm256_cmp_pd(e, floor, _CMP_GE_OQ), one));
+    // quantize's operations: mins rounded down, maxes up (ceil = floor + (floor < v) on these values).
+    const __m256d vMin = _mm256_min_pd(_mm256_max_pd(_mm256_mul_pd(_mm256_sub_pd(mins, origin), scale), zero), top);
+    const __m256d vMax = _mm256_min_pd(_mm256_max_pd(_mm256_mul_pd(_mm256_sub_pd(maxs, origin), scale), zero), top);
+    const __m128i low = _mm256_cvttpd_epi32(_mm256_round_pd(vMin, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC));
+    const __m128i high = _mm256_cvttpd_epi32(_mm256_round_pd(vMax, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(&keys[i].min[0]), low);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(&keys[i].max[0]), high);
+    const __m128i cells = _mm_sub_epi32(_mm_srl_epi32(high, shift), _mm_srl_epi32(low, shift));
+    wide = _mm_or_si128(wide, _mm_and_si128(_mm_cmpgt_epi32(cells, oneKey), axes));
+  }
+  lanes.addTo(brief);
+  alignas(32) std::array<double, 4> t;
+  _mm256_store_pd(t.data(), count);
+  for (int a = 0; a < 3; ++a) brief.top[a] += static_cast<std::size_t>(t[a]);
+  return _mm_movemask_epi8(wide) == 0;
 }
 #endif
 
@@ -134,17 +215,8 @@ ExtentSurvey surveyExtents(const BinningParams& p, std::span<const Aabb> boxes) 
   else
     checkBoxes(boxes);
   completeBrief(boxes, from, brief);
-  // The common frame: every extent finite, and more than the outliers in the longest's top buckets, so the
-  // (outliers + 1)-th longest is there too and no extent is an outlier: the brief's two vector passes tell.
-  bool common = true;
-  for (int a = 0; a < 3; ++a) common = common && brief.notFinite[a] == 0 && brief.top[a] > outliers && topFloor(brief.longest[a]) > 0;
-  if (common) {
-    survey.bounds = brief.bounds;
-    survey.allWithin = true;
-    // A box of e spans at most e / unit + 2 keys after the outward rounding; 2^s keys make a cell.
-    for (int a = 0; a < 3; ++a) survey.cellEdge[a] = brief.longest[a] * keys / (keys - 4);
-    return survey;
-  }
+  // The common frame, which the brief's two vector passes tell.
+  if (isCommon(brief, boxes.size())) return commonSurvey(p, brief);
   // Otherwise per axis a count of the extents by binary exponent, to find the outliers.
   std::array<std::array<std::uint32_t, kNotFinite + 1>, 3> count{};
   for (const Aabb& b : boxes)
@@ -167,8 +239,41 @@ ExtentSurvey surveyExtents(const BinningParams& p, std::span<const Aabb> boxes) 
     }
     survey.allWithin = survey.allWithin && count[a][kNotFinite] == 0;
     survey.cellEdge[a] = reach * keys / (keys - 4);
+    survey.topFloor[a] = topFloor(brief.longest[a]);
   }
   return survey;
+}
+
+std::optional<CommonPass> surveyCommonOnGrid(const BinningParams& p, std::span<const Aabb> boxes, const KeyGrid& grid,
+                                             const std::array<double, 3>& guessedFloor, std::span<KeyBox> keys) {
+#if defined(__x86_64__)
+  const double int32Keys = 0x7fffffff;
+  if (!cpuHasAvx2() || boxes.size() < 2 || !(grid.top[0] <= int32Keys && grid.top[1] <= int32Keys &&
+                                             grid.top[2] <= int32Keys))
+    return std::nullopt;
+  ExtentBrief brief;
+  bool keysFit = commonPassAvx2(grid, guessedFloor, boxes, brief, keys);
+  // The last box, which the vector loop leaves: a NaN or inverted one is surveyExtents' to name.
+  const std::size_t last = boxes.size() - 1;
+  const Aabb& b = boxes[last];
+  for (int a = 0; a < 3; ++a) {
+    const double e = double{b.max[a]} - double{b.min[a]};
+    if (!(e >= 0)) return std::nullopt;
+    brief.top[a] += e >= guessedFloor[a];
+  }
+  if (!brief.checked) return std::nullopt;
+  briefScalar(boxes, last, brief);
+  keys[last] = quantize(grid, b);
+  keysFit = keysFit && fitsCells(grid, keys[last]);
+  // The top buckets were counted from the guessed floor: they are the frame's only if its longest extents have it.
+  for (int a = 0; a < 3; ++a)
+    if (topFloor(brief.longest[a]) != guessedFloor[a]) return std::nullopt;
+  if (!isCommon(brief, boxes.size())) return std::nullopt;
+  return CommonPass{commonSurvey(p, brief), keysFit};
+#else
+  (void)p, (void)boxes, (void)grid, (void)guessedFloor, (void)keys;
+  return std::nullopt;
+#endif
 }
 
 void AxisBounds::add(const Aabb& b) {

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -64,9 +65,26 @@ struct ExtentSurvey {
   std::array<double, 3> cellEdge{};
   AxisBounds bounds;       // of every box
   bool allWithin = false;  // no outlier and no infinite extent: every box is within the cell edge
+  /// Per axis, the floor of the longest finite extent's binary exponent bucket and the one below (its top
+  /// buckets, which decide whether any extent is an outlier): what a one-pass survey of the next frame guesses.
+  std::array<double, 3> topFloor{};
 };
 /// The survey of `boxes`, which it checks as checkBoxes does (in its first
 /// pass where it can): throws InputError for the first bad box.
 ExtentSurvey surveyExtents(const BinningParams& p, std::span<const Aabb> boxes);
+
+/// A common frame's survey (every box checked, every extent finite, no outlier: `allWithin`) and its keys on a
+/// grid chosen before, from one pass over the boxes.
+struct CommonPass {
+  ExtentSurvey survey;
+  bool keysFit = false;  // every box's keys on the grid fit two cells (fitsCells)
+};
+/// surveyExtents and quantizeAll in one pass over `boxes` (keys[k] for boxes[k]; keys is boxes.size() long),
+/// for a frame whose longest extents have the top floors guessed (the last frame's): the survey is
+/// surveyExtents' and the keys quantize's, bit for bit. nullopt when the frame is not such a common frame (a
+/// box to check, an infinite extent, another floor, an outlier), when the CPU has no AVX2, or for fewer than two
+/// boxes: surveyExtents' path then decides, and keys holds nothing of use.
+std::optional<CommonPass> surveyCommonOnGrid(const BinningParams& p, std::span<const Aabb> boxes, const KeyGrid& grid,
+                                             const std::array<double, 3>& guessedFloor, std::span<KeyBox> keys);
 
 }  // namespace bpaccel

@@ -7,9 +7,11 @@
 #include <bit>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <random>
 
 #include "broad_phase/binning_grid.hpp"
+#include "core/cpu_features.hpp"
 
 namespace bpaccel {
 namespace {
@@ -120,6 +122,63 @@ TEST(SurveyExtents, FollowsItsRuleOnScenesWithAndWithoutOutliers) {
       }
     }
   }
+}
+
+TEST(SurveyCommonOnGrid, GivesSurveyExtentsAndQuantizesResultsInOnePassOrDeclines) {
+  if (!cpuHasAvx2()) GTEST_SKIP() << "the one pass is AVX2 code";
+  BinningParams p;
+  p.keyWidth = 16, p.cellBits = 4;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> centre(-50, 50), size(0.5f, 2.0f);
+  int onePass = 0;
+  for (std::size_t n : {0, 1, 2, 3, 255, 257, 2000})
+    for (int kind = 0; kind < 6; ++kind) {
+      std::vector<Aabb> boxes(n);
+      for (std::size_t i = 0; i < n; ++i)
+        for (int a = 0; a < 3; ++a) {
+          float e = size(rng);
+          if (kind == 1 && i % 400 == 5) e *= 1000;  // outliers, below n / 256 or not, by n
+          boxes[i].min[a] = centre(rng);
+          boxes[i].max[a] = boxes[i].min[a] + e;
+        }
+      if (kind == 2 && n > 0) boxes[n - 1].max[2] = HUGE_VALF;             // infinite, the last box
+      if (kind == 3 && n > 1) boxes[n / 2].min[0] = boxes[n / 2].max[0] + 1;  // inverted
+      if (kind == 4 && n > 0) boxes[n - 1].max[1] = NAN;                    // NaN, the last box
+      const std::string what = "n " + std::to_string(n) + " kind " + std::to_string(kind);
+      const bool bad = (kind == 3 && n > 1) || (kind == 4 && n > 0);
+      const ExtentSurvey want = bad ? ExtentSurvey{} : surveyExtents(p, boxes);
+      const KeyGrid g = randomGrid(rng, p.keyWidth);
+      std::vector<KeyBox> keys(n);
+      for (bool rightGuess : {true, false}) {
+        std::array<double, 3> guess = want.topFloor;
+        if (!rightGuess) guess[rng() % 3] *= 2;
+        const std::optional<CommonPass> got = surveyCommonOnGrid(p, boxes, g, guess, keys);
+        // It declines a bad box (surveyExtents names it), a wrong guess and any frame surveyExtents finds uncommon.
+        if (bad || !rightGuess || n < 2 || kind == 2) {
+          EXPECT_FALSE(got) << what << " guess " << rightGuess;
+          continue;
+        }
+        if (kind == 1 && !want.allWithin) EXPECT_FALSE(got) << what;
+        if (!got) continue;
+        onePass += 1;
+        EXPECT_TRUE(got->survey.allWithin) << what;
+        bool wantFit = true;
+        for (int a = 0; a < 3; ++a) {
+          EXPECT_EQ(got->survey.cellEdge[a], want.cellEdge[a]) << what << " axis " << a;
+          EXPECT_EQ(got->survey.bounds.lo[a], want.bounds.lo[a]) << what << " axis " << a;
+          EXPECT_EQ(got->survey.bounds.hi[a], want.bounds.hi[a]) << what << " axis " << a;
+          EXPECT_EQ(got->survey.topFloor[a], want.topFloor[a]) << what << " axis " << a;
+        }
+        for (std::size_t k = 0; k < n; ++k) {
+          const KeyBox key = quantize(g, boxes[k]);
+          wantFit = wantFit && fitsCells(g, key);
+          ASSERT_EQ(keys[k].min, key.min) << what << " box " << k;
+          ASSERT_EQ(keys[k].max, key.max) << what << " box " << k;
+        }
+        EXPECT_EQ(got->keysFit, wantFit) << what;
+      }
+    }
+  EXPECT_GE(onePass, 4) << "the one pass never ran: the test compared nothing";
 }
 
 }  // namespace
