@@ -77,12 +77,17 @@ test: deps
 # The Chisel generator: golden model, ChiselTest (Scala simulator and Verilator),
 # Verilog lint and memory structure. The same sbt session then emits the
 # Verilog the host and the FPGA flow's test build, where it is out of date,
-# which spares each an sbt start-up.
+# which spares each an sbt start-up, and in one forked JVM (EmitAll), which
+# spares each a JVM's.
 test-hw: deps
-	$(SBT) test $(if $(call stale,$(HOST_VERILOG)/filelist.f),$(EMIT_HOST)) \
-	  $(if $(call stale,$(BINNING_PARAMS_DIR)/bpaccel_binning_params.h),$(EMIT_BINNING_PARAMS)) \
-	  $(if $(call stale,$(HOST_FRAME_SHELL)/filelist.f),$(EMIT_HOST_FRAME_SHELL)) \
-	  $(if $(call stale,$(FPGA_TEST_VERILOG)/filelist.f $(FPGA_TEST_STREAM_VERILOG)/filelist.f),$(EMIT_FPGA_TEST))
+	$(SBT) test $(call emit,$(if $(call stale,$(HOST_VERILOG)/filelist.f),$(EMIT_HOST) +) \
+	  $(if $(call stale,$(BINNING_PARAMS_DIR)/bpaccel_binning_params.h),$(EMIT_BINNING_PARAMS) +) \
+	  $(if $(call stale,$(HOST_FRAME_SHELL)/filelist.f),$(EMIT_HOST_FRAME_SHELL) +) \
+	  $(if $(call stale,$(FPGA_TEST_VERILOG)/filelist.f $(FPGA_TEST_STREAM_VERILOG)/filelist.f),$(EMIT_FPGA_TEST)))
+
+# The sbt command that runs emitters ("EmitShell <options> + EmitBinning
+# <options> ...") in one forked JVM (bpaccel.EmitAll); nothing for none.
+emit = $(if $(strip $(1)),"runMain bpaccel.EmitAll $(strip $(1))")
 
 # The formal checks at depths that cover a whole run of each small
 # configuration (docs/verification.md); `make test` runs shallower ones.
@@ -90,15 +95,15 @@ formal-long: deps
 	BPACCEL_FORMAL_LONG=1 $(SBT) "testOnly bpaccel.FormalSpec bpaccel.FormalMutantSpec bpaccel.binning.BinningFormalSpec"
 
 # The C++ host (build/bin/bpaccel, build/bin/bpaccel-bench) with the Verilated shell and core, and its tests.
-EMIT_HOST = "runMain bpaccel.shell.EmitShell $(EMIT_ARGS) --stream-bits $(HOST_STREAM_BITS) --dual-clock $(HOST_DUAL_CLOCK) --target-dir $(HOST_VERILOG)"
+EMIT_HOST = EmitShell $(EMIT_ARGS) --stream-bits $(HOST_STREAM_BITS) --dual-clock $(HOST_DUAL_CLOCK) --target-dir $(HOST_VERILOG)
 $(HOST_VERILOG)/filelist.f: $(SCALA_SOURCES) $(wildcard src/bpaccel/shell/*.scala) | deps
-	$(SBT) $(EMIT_HOST)
+	$(SBT) $(call emit,$(EMIT_HOST))
 
 # The binning device's C header and JSON parameters (EmitBinning --params-only), for the host's model of it.
 BINNING_PARAMS_DIR := build/host-binning
-EMIT_BINNING_PARAMS = "runMain bpaccel.binning.EmitBinning --params-only --target-dir $(BINNING_PARAMS_DIR)"
+EMIT_BINNING_PARAMS = EmitBinning --params-only --target-dir $(BINNING_PARAMS_DIR)
 $(BINNING_PARAMS_DIR)/bpaccel_binning_params.h: $(SCALA_SOURCES) $(wildcard src/bpaccel/binning/*.scala) | deps
-	$(SBT) $(EMIT_BINNING_PARAMS)
+	$(SBT) $(call emit,$(EMIT_BINNING_PARAMS))
 
 # A small binning shell, verilated for the tests of the driver's FRAME path
 # against the hardware (host/src/device/rtl/frame): 8 lane groups of 2
@@ -106,9 +111,9 @@ $(BINNING_PARAMS_DIR)/bpaccel_binning_params.h: $(SCALA_SOURCES) $(wildcard src/
 HOST_FRAME_SHELL := build/host-shell/binning-g8-c512-w128
 HOST_FRAME_SHELL_ARGS := --group-bits 1,1,1 --lanes-per-group 2 --cell-bits 4 --capacity 512 --group-capacity 256 \
   --intake-boxes 4 --pairs-per-beat 4 --stream-bits 128 --dual-clock true
-EMIT_HOST_FRAME_SHELL = "runMain bpaccel.shell.EmitShell --arch binning $(HOST_FRAME_SHELL_ARGS) --target-dir $(HOST_FRAME_SHELL)"
+EMIT_HOST_FRAME_SHELL = EmitShell --arch binning $(HOST_FRAME_SHELL_ARGS) --target-dir $(HOST_FRAME_SHELL)
 $(HOST_FRAME_SHELL)/filelist.f: $(SCALA_SOURCES) $(wildcard src/bpaccel/shell/*.scala src/bpaccel/binning/*.scala) | deps
-	$(SBT) $(EMIT_HOST_FRAME_SHELL)
+	$(SBT) $(call emit,$(EMIT_HOST_FRAME_SHELL))
 HOST_GENERATED := $(HOST_VERILOG)/filelist.f $(BINNING_PARAMS_DIR)/bpaccel_binning_params.h $(HOST_FRAME_SHELL)/filelist.f
 HOST_GENERATED_DIRS := -DBPACCEL_VERILOG_DIR=$(abspath $(HOST_VERILOG)) -DBPACCEL_BINNING_DIR=$(abspath $(BINNING_PARAMS_DIR)) \
   -DBPACCEL_FRAME_SHELL_DIR=$(abspath $(HOST_FRAME_SHELL))
@@ -239,10 +244,10 @@ fpga-sweep: deps
 	$(PYTHON) scripts/fpga/sweep.py --arch $(ARCH) --key-width $(KEY_WIDTH) $(if $(CAPACITY),--capacity $(CAPACITY)) $(if $(FPGA_MEMORY_STYLE),--memory-style $(FPGA_MEMORY_STYLE)) --verilog-root build/fpga-verilog --emit always --budget-min 60
 
 # Both architectures at m = 2 (the stream with a small memory, so the flow stays quick), emitted by one sbt run.
-EMIT_FPGA_TEST = "runMain bpaccel.EmitVerilog --arch seed --m 2 --target-dir $(FPGA_TEST_VERILOG)" \
-                 "runMain bpaccel.EmitVerilog --arch stream --m 2 --capacity 512 --target-dir $(FPGA_TEST_STREAM_VERILOG)"
+EMIT_FPGA_TEST = EmitVerilog --arch seed --m 2 --target-dir $(FPGA_TEST_VERILOG) + \
+                 EmitVerilog --arch stream --m 2 --capacity 512 --target-dir $(FPGA_TEST_STREAM_VERILOG)
 $(FPGA_TEST_VERILOG)/filelist.f $(FPGA_TEST_STREAM_VERILOG)/filelist.f &: $(SCALA_SOURCES) | deps
-	$(SBT) $(EMIT_FPGA_TEST)
+	$(SBT) $(call emit,$(EMIT_FPGA_TEST))
 # Options for flow.py, e.g. FPGA_ARGS="--router router2 --threads 2".
 FPGA_ARGS ?=
 
