@@ -27,3 +27,15 @@ object EmitAll {
         sys.exit(2)
     }
 }
+
+/** What the emitters' mains share. */
+object Emitter {
+  /** The parameters `build` makes; a failed requirement is a usage error naming the emitter (status 2). */
+  def parametersOrExit[P](emitter: String)(build: => P): P =
+    try build
+    catch {
+      case e: IllegalArgumentException =>
+        System.err.println(s"$emitter: invalid parameters: ${e.getMessage.stripPrefix("requirement failed: ")}")
+        sys.exit(2)
+    }
+}

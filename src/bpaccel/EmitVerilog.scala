@@ -129,13 +129,7 @@ object EmitVerilog {
     // Parameters are validated when the case class is built; report that as a usage error.
     parser.parse(args, Options()) match {
       case Some(o) =>
-        val params =
-          try o.params
-          catch {
-            case e: IllegalArgumentException =>
-              System.err.println(s"EmitVerilog: invalid parameters: ${e.getMessage.stripPrefix("requirement failed: ")}")
-              sys.exit(2)
-          }
+        val params = Emitter.parametersOrExit("EmitVerilog")(o.params)
         val out = emit(params, o.targetDir)
         println(s"wrote $out, ${CHeader.fileName} and ${ParamsJson.fileName} for $params")
       case None => sys.exit(2)

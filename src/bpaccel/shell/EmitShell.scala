@@ -5,7 +5,7 @@ import java.nio.file.{Files, Path, Paths}
 import chisel3.stage.ChiselGeneratorAnnotation
 import circt.stage.{ChiselStage, FirtoolOption}
 
-import bpaccel.{AccelParams, Arch, EmitVerilog, MemoryStyle, SingleClockMemories}
+import bpaccel.{AccelParams, Arch, EmitVerilog, Emitter, MemoryStyle, SingleClockMemories}
 import bpaccel.binning.{BinningParams, EmitBinning}
 
 /** Emits the shell of one configuration: its SystemVerilog (one file per
@@ -116,13 +116,7 @@ object EmitShell {
     }
     parser.parse(args, Options()) match {
       case Some(o) =>
-        val p =
-          try o.params
-          catch {
-            case e: IllegalArgumentException =>
-              System.err.println(s"EmitShell: invalid parameters: ${e.getMessage.stripPrefix("requirement failed: ")}")
-              sys.exit(2)
-          }
+        val p = Emitter.parametersOrExit("EmitShell")(o.params)
         println(s"wrote ${emit(p, o.targetDir, o.smokeTestbench)} for ${p.fingerprint}")
       case None => sys.exit(2)
     }
