@@ -38,17 +38,6 @@ void BinningFrame::plan(std::span<const Aabb> boxes) {
   isLong_.assign(boxes.size(), 0);
   cellEdge_ = survey.cellEdge;
   PlannedFrame whole = takeSpare();
-  if (steady) {  // every box within the cell edge: one frame
-    whole.ids.resize(boxes.size());
-    std::iota(whole.ids.begin(), whole.ids.end(), 0u);
-    whole.grid = steady->grid;
-    whole.region = Region{};
-    if (steady->keysDone) std::swap(whole.keys, steadyKeys_), stats_.onePass = true;
-    frames_.push_back(std::move(whole));
-    if (!steady->keysDone) fillKeys(frames_.back());
-    steady_.keep(frames_.back().grid, survey);
-    return;
-  }
   AxisBounds bounds = survey.bounds;
   if (survey.allWithin) {
     whole.ids.resize(boxes.size());
@@ -57,10 +46,13 @@ void BinningFrame::plan(std::span<const Aabb> boxes) {
     bounds = keepFitting(whole.ids);
   }
   if (whole.ids.size() <= p.boxCapacity) {  // the common frame: one device frame
-    whole.grid = gridFor(p, bounds, cellEdge_);
+    // The steady pass's grid is the kept one, or gridFor these bounds when the kept no longer serves.
+    whole.grid = steady ? steady->grid : gridFor(p, bounds, cellEdge_);
     whole.region = Region{};
+    const bool keysDone = steady && steady->keysDone;
+    if (keysDone) std::swap(whole.keys, steadyKeys_), stats_.onePass = true;
     frames_.push_back(std::move(whole));
-    fillKeys(frames_.back());
+    if (!keysDone) fillKeys(frames_.back());
     if (survey.allWithin) steady_.keep(frames_.back().grid, survey);
     else steady_.forget();
     return;

@@ -120,6 +120,12 @@ __attribute__((target("avx2"))) std::size_t topAvx2(std::span<const Aabb> boxes,
 }
 #endif
 
+/// Whether the grid's keys fit an int32, as the vector loops' signed conversion needs.
+bool keysFitInt32(const KeyGrid& grid) {
+  const double int32Keys = 0x7fffffff;
+  return grid.top[0] <= int32Keys && grid.top[1] <= int32Keys && grid.top[2] <= int32Keys;
+}
+
 /// The survey of a common frame (every extent finite, none an outlier) from its brief.
 ExtentSurvey commonSurvey(const BinningParams& p, const ExtentBrief& brief) {
   const double keys = std::ldexp(1.0, static_cast<int>(p.maxShift()));
@@ -247,10 +253,7 @@ ExtentSurvey surveyExtents(const BinningParams& p, std::span<const Aabb> boxes) 
 std::optional<CommonPass> surveyCommonOnGrid(const BinningParams& p, std::span<const Aabb> boxes, const KeyGrid& grid,
                                              const std::array<double, 3>& guessedFloor, std::span<KeyBox> keys) {
 #if defined(__x86_64__)
-  const double int32Keys = 0x7fffffff;
-  if (!cpuHasAvx2() || boxes.size() < 2 || !(grid.top[0] <= int32Keys && grid.top[1] <= int32Keys &&
-                                             grid.top[2] <= int32Keys))
-    return std::nullopt;
+  if (!cpuHasAvx2() || boxes.size() < 2 || !keysFitInt32(grid)) return std::nullopt;
   ExtentBrief brief;
   bool keysFit = commonPassAvx2(grid, guessedFloor, boxes, brief, keys);
   // The last box, which the vector loop leaves: a NaN or inverted one is surveyExtents' to name.
@@ -368,8 +371,7 @@ __attribute__((target("avx2"))) bool quantizeAvx2(const KeyGrid& g, std::span<co
 bool quantizeAll(const KeyGrid& grid, std::span<const Aabb> boxes, std::span<const std::uint32_t> ids,
                  std::span<KeyBox> keys) {
 #if defined(__x86_64__)
-  const double int32Keys = 0x7fffffff;
-  if (cpuHasAvx2() && grid.top[0] <= int32Keys && grid.top[1] <= int32Keys && grid.top[2] <= int32Keys)
+  if (cpuHasAvx2() && keysFitInt32(grid))
     return quantizeAvx2(grid, boxes, ids, keys);
 #endif
   bool allFit = true;
