@@ -112,6 +112,12 @@ class QueueRoom(p: BinningParams) extends Bundle {
   * counting each group's entries as they are queued, so errors come in
   * stream order. The boxes port is ready while the register is empty or moves
   * on, until the beat with `last` is taken.
+  *
+  * Whether the held beat moves is decided over all groups in one cycle, and
+  * it enables every register of the next beat. So what the decision reads of
+  * the held beat (which groups each box covers, how many entries it brings
+  * each group, whether a box has an error) is computed as the beat is taken
+  * and registered beside it: the decision starts from registers.
   */
 class Intake(p: BinningParams) extends Module {
   private val w = p.intakeBoxes
@@ -135,6 +141,9 @@ class Intake(p: BinningParams) extends Module {
   val errorRaised = RegInit(false.B)
   val held        = RegInit(false.B)
   val beat        = Reg(Vec(w, new BoxCells(p)))
+  val beatCovers  = Reg(Vec(p.groups, Vec(w, Bool()))) // of the held beat: lane l's box covers a cell of group gr
+  val beatCounts  = Reg(Vec(p.groups, UInt(log2Ceil(w + 1).W))) // ... the entries it brings to group gr
+  val beatError   = Reg(Bool()) // ... a box of it has an error of its own
   val beatEnd     = Reg(UInt(32.W)) // boxes received once this beat is counted
   val count       = PopCount(io.boxes.bits.boxes.map(_.valid))
   // Entries each group may still take (GROUP_OVERFLOW past it), and the same capped at w: a beat
@@ -164,11 +173,10 @@ class Intake(p: BinningParams) extends Module {
   // (counted without the error term, which only matters when a lane's own
   // error raises anyway), else the last beat short of n (decided when the
   // beat was taken: n is fixed during the intake).
-  val boxError  = (0 until w).map(l => beat(l).valid && beat(l).error =/= BinningError.None).reduce(_ || _)
-  val covers    = Seq.tabulate(p.groups, w)((gr, l) => beat(l).valid && BoxCells.covers(p, beat(l), gr))
-  val overflows = (0 until p.groups).map(gr => PopCount(covers(gr)) > cappedRoom(gr))
+  val covers    = beatCovers.map(_.toSeq)
+  val overflows = (0 until p.groups).map(gr => beatCounts(gr) > cappedRoom(gr))
   val endsShort = RegEnable(io.boxes.bits.last && received + count < io.n, io.boxes.fire) // of the held beat
-  val raising   = boxError || overflows.reduce(_ || _) || endsShort
+  val raising   = beatError || overflows.reduce(_ || _) || endsShort
   val raises    = held && !errorRaised && raising
   val queued    = (0 until p.groups).map { gr =>
     val r = io.groups(gr).room
@@ -185,7 +193,7 @@ class Intake(p: BinningParams) extends Module {
   for (gr <- 0 until p.groups) {
     io.groups(gr).offer := VecInit(entries(gr))
     io.groups(gr).push  := pushes && covers(gr).reduce(_ || _)
-    val left = room(gr) - PopCount(covers(gr))
+    val left = room(gr) - beatCounts(gr)
     when(pushes) { room(gr) := left; cappedRoom(gr) := capped(left) }
   }
 
@@ -193,8 +201,14 @@ class Intake(p: BinningParams) extends Module {
   io.boxes.ready := io.active && !lastTaken && (!held || moves)
   if (p.has(BinningFault.ReceivedCountsOffers)) when(io.boxes.valid && !io.boxes.ready) { received := received + count }
   when(io.boxes.fire) {
-    for (l <- 0 until w)
-      beat(l) := BoxCells(p, io.boxes.bits.boxes(l), received + l.U, io.n, io.shift, io.dims)
+    val decoded = (0 until w).map(l => BoxCells(p, io.boxes.bits.boxes(l), received + l.U, io.n, io.shift, io.dims))
+    for (l <- 0 until w) beat(l) := decoded(l)
+    for (gr <- 0 until p.groups) {
+      val c = decoded.map(d => d.valid && BoxCells.covers(p, d, gr))
+      beatCovers(gr) := VecInit(c)
+      beatCounts(gr) := PopCount(c)
+    }
+    beatError := decoded.map(d => d.valid && d.error =/= BinningError.None).reduce(_ || _)
     beatEnd  := received + count
     received := received + count
     when(io.boxes.bits.last) { lastTaken := true.B }
