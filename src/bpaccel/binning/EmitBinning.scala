@@ -5,7 +5,7 @@ import java.nio.file.{Files, Path, Paths}
 import chisel3.stage.ChiselGeneratorAnnotation
 import circt.stage.{ChiselStage, FirtoolOption}
 
-import bpaccel.{DistributedMemories, EmitVerilog, MemoryStyle, NoCollisionMemories, RegisterMemories, SingleClockMemories}
+import bpaccel.{DistributedMemories, EmitVerilog, Emitter, MemoryStyle, NoCollisionMemories, RegisterMemories, SingleClockMemories}
 
 /** Emits one binning configuration: SystemVerilog (one file per module and
   * filelist.f), its C header and its JSON parameter file.
@@ -56,38 +56,47 @@ object EmitBinning {
     Files.writeString(targetDir.resolve(jsonFile), BinningHeader.json(p))
   }
 
-  private case class Options(p: BinningParams = BinningParams(), targetDir: Path = Paths.get("generated/binning"),
-                             paramsOnly: Boolean = false)
+  /** EmitBinning's command line: the core's settings, applied in one step, and where the files go. */
+  final case class Options(b: BinningOptions = BinningOptions(), targetDir: Path = Paths.get("generated/binning"),
+                           paramsOnly: Boolean = false)
 
-  def main(args: Array[String]): Unit = {
+  /** The options `args` give, or None when they do not parse (scopt has then printed why). */
+  def parse(args: Seq[String]): Option[Options] = {
     val d = BinningParams()
     val parser = new scopt.OptionParser[Options]("EmitBinning") {
       head("Emits the binning device's SystemVerilog, C header and JSON parameters")
-      opt[String]("group-bits").action((v, o) => o.copy(p = o.p.copy(groupBits = v.split("[x,]").map(_.toInt).toSeq)))
+      opt[String]("group-bits").validate(v => BinningOptions.groupBitsError(v).toLeft(()))
+        .action((v, o) => o.copy(b = o.b.copy(groupBits = Some(BinningOptions.groupBitsOf(v)))))
         .text(s"ax,ay,az: 2^a groups per axis (default ${d.groupBits.mkString(",")})")
-      opt[Int]("lanes-per-group").action((v, o) => o.copy(p = o.p.copy(lanesPerGroup = v))).text(s"g (default ${d.g})")
-      opt[Int]("key-width").action((v, o) => o.copy(p = o.p.copy(keyWidth = v))).text(s"default ${d.keyWidth}")
-      opt[Int]("cell-bits").action((v, o) => o.copy(p = o.p.copy(cellBits = v))).text(s"default ${d.cellBits}")
-      opt[Int]("box-capacity").action((v, o) => o.copy(p = o.p.copy(boxCapacity = v))).text(s"default ${d.boxCapacity}")
-      opt[Int]("group-capacity").action((v, o) => o.copy(p = o.p.copy(groupCapacity = v))).text(s"default ${d.groupCapacity}")
-      opt[Int]("intake-boxes").action((v, o) => o.copy(p = o.p.copy(intakeBoxes = v))).text(s"default ${d.intakeBoxes}")
-      opt[Int]("pairs-per-beat").action((v, o) => o.copy(p = o.p.copy(pairsPerBeat = v))).text(s"default ${d.pairsPerBeat}")
-      opt[Int]("memory-output-stages").action((v, o) => o.copy(p = o.p.copy(memoryOutputStages = v)))
+      opt[Int]("lanes-per-group").action((v, o) => o.copy(b = o.b.copy(lanesPerGroup = Some(v)))).text(s"g (default ${d.g})")
+      opt[Int]("key-width").action((v, o) => o.copy(b = o.b.copy(keyWidth = Some(v)))).text(s"default ${d.keyWidth}")
+      opt[Int]("cell-bits").action((v, o) => o.copy(b = o.b.copy(cellBits = Some(v)))).text(s"default ${d.cellBits}")
+      opt[Int]("box-capacity").action((v, o) => o.copy(b = o.b.copy(boxCapacity = Some(v)))).text(s"default ${d.boxCapacity}")
+      opt[Int]("group-capacity").action((v, o) => o.copy(b = o.b.copy(groupCapacity = Some(v))))
+        .text(s"default ${d.groupCapacity}")
+      opt[Int]("intake-boxes").action((v, o) => o.copy(b = o.b.copy(intakeBoxes = Some(v)))).text(s"default ${d.intakeBoxes}")
+      opt[Int]("pairs-per-beat").action((v, o) => o.copy(b = o.b.copy(pairsPerBeat = Some(v))))
+        .text(s"default ${d.pairsPerBeat}")
+      opt[Int]("memory-output-stages").action((v, o) => o.copy(b = o.b.copy(memoryOutputStages = Some(v))))
         .text(s"default ${d.memoryOutputStages}")
-      opt[String]("memory-style").action((v, o) => o.copy(p = o.p.copy(memoryStyle = MemoryStyle.fromName(v))))
+      opt[String]("memory-style").action((v, o) => o.copy(b = o.b.copy(memoryStyle = Some(v))))
         .text(s"${MemoryStyle.all.map(_.name).mkString(" or ")} (default ${d.memoryStyle.name})")
-      opt[Boolean]("debug-port").action((v, o) => o.copy(p = o.p.copy(debugPort = v)))
+      opt[Boolean]("debug-port").action((v, o) => o.copy(b = o.b.copy(debugPort = Some(v))))
       opt[Unit]("params-only").action((_, o) => o.copy(paramsOnly = true))
         .text("write only the C header and the JSON parameter file")
       opt[String]("target-dir").action((v, o) => o.copy(targetDir = Paths.get(v))).text("output folder")
     }
-    parser.parse(args, Options()) match {
-      case Some(o) if o.paramsOnly =>
-        emitParams(o.p, o.targetDir)
-        println(s"wrote $headerFile and $jsonFile in ${o.targetDir} for ${o.p}")
+    parser.parse(args, Options())
+  }
+
+  def main(args: Array[String]): Unit = {
+    parse(args.toSeq) match {
       case Some(o) =>
-        val out = emit(o.p, o.targetDir)
-        println(s"wrote $out, $headerFile and $jsonFile for ${o.p}")
+        val p = Emitter.parametersOrExit("EmitBinning")(o.b.params())
+        if (o.paramsOnly) {
+          emitParams(p, o.targetDir)
+          println(s"wrote $headerFile and $jsonFile in ${o.targetDir} for $p")
+        } else println(s"wrote ${emit(p, o.targetDir)}, $headerFile and $jsonFile for $p")
       case None => sys.exit(2)
     }
   }

@@ -6,7 +6,7 @@ import chisel3.stage.ChiselGeneratorAnnotation
 import circt.stage.{ChiselStage, FirtoolOption}
 
 import bpaccel.{AccelParams, Arch, EmitVerilog, Emitter, MemoryStyle, SingleClockMemories}
-import bpaccel.binning.{BinningParams, EmitBinning}
+import bpaccel.binning.{BinningOptions, BinningParams, EmitBinning}
 
 /** Emits the shell of one configuration: its SystemVerilog (one file per
   * module, filelist.f), the core's bpaccel_params.h, the shell's
@@ -66,7 +66,7 @@ object EmitShell {
     keyWidth: Option[Int] = None,
     batchCells: Int = AccelParams().batchCells,
     memoryStyle: String = MemoryStyle.Inferred.name,
-    binning: BinningParams = BinningParams(),
+    binning: BinningOptions = BinningOptions(),
     streamBits: Int = ShellParams().streamBits,
     dualClock: Boolean = true,
     fifoDepth: Int = ShellParams().fifoDepth,
@@ -77,8 +77,7 @@ object EmitShell {
       val archs = Arch.all.map(_.name) :+ "binning"
       require(archs.contains(arch), s"arch must be one of ${archs.mkString(", ")}, got arch = $arch")
       if (arch == "binning")
-        binning.copy(boxCapacity = capacity.getOrElse(binning.boxCapacity), keyWidth = keyWidth.getOrElse(binning.keyWidth),
-          memoryStyle = MemoryStyle.fromName(memoryStyle))
+        binning.copy(boxCapacity = capacity, keyWidth = keyWidth, memoryStyle = Some(memoryStyle)).params()
       else
         AccelParams(m = m, capacity = capacity.getOrElse(Arch.fromName(arch).defaultCapacity(m)), keyWidth = keyWidth.getOrElse(32),
           arch = Arch.fromName(arch), batchCells = batchCells, memoryStyle = MemoryStyle.fromName(memoryStyle))
@@ -90,7 +89,7 @@ object EmitShell {
     val parser = new scopt.OptionParser[Options]("EmitShell") {
       head("Emits the bpaccel AXI shell's SystemVerilog, C headers, SystemRDL and register page")
       val b = BinningParams()
-      def binning(name: String, doc: String)(set: (BinningParams, Int) => BinningParams) =
+      def binning(name: String, doc: String)(set: (BinningOptions, Int) => BinningOptions) =
         opt[Int](name).action((v, o) => o.copy(binning = set(o.binning, v))).text(s"binning: $doc")
       opt[String]("arch").action((v, o) => o.copy(arch = v)).text("core architecture: seed, stream or binning (default stream)")
       opt[Int]("m").action((v, o) => o.copy(m = v)).text("seed, stream: lanes")
@@ -98,13 +97,14 @@ object EmitShell {
         .text(s"boxes per cell (seed, stream; default: the architecture's) or per frame (binning; default ${b.boxCapacity})")
       opt[Int]("key-width").action((v, o) => o.copy(keyWidth = Some(v))).text(s"bits per key (at most 32; default 32, binning ${b.keyWidth})")
       opt[Int]("batch-cells").action((v, o) => o.copy(batchCells = v)).text("seed, stream: cell counts the core queues")
-      opt[String]("group-bits").action((v, o) => o.copy(binning = o.binning.copy(groupBits = v.split("[x,]").map(_.toInt).toSeq)))
+      opt[String]("group-bits").validate(v => BinningOptions.groupBitsError(v).toLeft(()))
+        .action((v, o) => o.copy(binning = o.binning.copy(groupBits = Some(BinningOptions.groupBitsOf(v)))))
         .text(s"binning: ax,ay,az, 2^a lane groups per axis (default ${b.groupBits.mkString(",")})")
-      binning("lanes-per-group", s"lanes of each group (default ${b.g})")((q, v) => q.copy(lanesPerGroup = v))
-      binning("cell-bits", s"grid cells per axis at most 2^cell-bits (default ${b.cellBits})")((q, v) => q.copy(cellBits = v))
-      binning("group-capacity", s"entries of each group's memory (default ${b.groupCapacity})")((q, v) => q.copy(groupCapacity = v))
-      binning("intake-boxes", s"boxes the core takes a cycle (default ${b.intakeBoxes})")((q, v) => q.copy(intakeBoxes = v))
-      binning("pairs-per-beat", s"pairs the core sends a cycle (default ${b.pairsPerBeat})")((q, v) => q.copy(pairsPerBeat = v))
+      binning("lanes-per-group", s"lanes of each group (default ${b.g})")((q, v) => q.copy(lanesPerGroup = Some(v)))
+      binning("cell-bits", s"grid cells per axis at most 2^cell-bits (default ${b.cellBits})")((q, v) => q.copy(cellBits = Some(v)))
+      binning("group-capacity", s"entries of each group's memory (default ${b.groupCapacity})")((q, v) => q.copy(groupCapacity = Some(v)))
+      binning("intake-boxes", s"boxes the core takes a cycle (default ${b.intakeBoxes})")((q, v) => q.copy(intakeBoxes = Some(v)))
+      binning("pairs-per-beat", s"pairs the core sends a cycle (default ${b.pairsPerBeat})")((q, v) => q.copy(pairsPerBeat = Some(v)))
       opt[String]("memory-style").action((v, o) => o.copy(memoryStyle = v)).text("inferred or ecp5-outreg")
       opt[Int]("stream-bits").action((v, o) => o.copy(streamBits = v)).text("TDATA bits: 64, 128, 256 or 512")
       opt[Boolean]("dual-clock").action((v, o) => o.copy(dualClock = v)).text("the core on core_clk (default true)")

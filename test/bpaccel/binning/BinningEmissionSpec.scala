@@ -37,6 +37,21 @@ class BinningEmissionSpec extends AnyFlatSpec with Matchers {
 
   behavior of "EmitBinning"
 
+  it should "apply its options in one step, so that their order does not decide whether they are valid" in {
+    // groupBits 5 needs cellBits >= 5: set one at a time, the first order checks 5,1,1 against the default 4.
+    val forward = EmitBinning.parse(Seq("--group-bits", "5,1,1", "--cell-bits", "5", "--key-width", "14"))
+    val backward = EmitBinning.parse(Seq("--key-width", "14", "--cell-bits", "5", "--group-bits", "5,1,1"))
+    val p = forward.get.b.params()
+    p shouldBe backward.get.b.params()
+    (p.groupBits, p.cellBits, p.keyWidth, p.boxCapacity) shouldBe ((Seq(5, 1, 1), 5, 14, BinningParams().boxCapacity))
+    // A combination that is invalid in any order is refused by name, when the parameters are built.
+    val refused = the[IllegalArgumentException] thrownBy
+      EmitBinning.parse(Seq("--cell-bits", "2", "--group-bits", "3,1,1")).get.b.params()
+    refused.getMessage should include("groupBits")
+    // A group-bits text that is not numbers is a usage error of the parser, not an exception.
+    EmitBinning.parse(Seq("--group-bits", "2,two,1")) shouldBe None
+  }
+
   it should "emit SystemVerilog that verilator --lint-only -Wall passes without a warning (the defaults)" in {
     val (_, dir) = default
     val (exit, log) = run(dir, Seq("verilator", "--lint-only", "-Wall", EmitVerilog.lintWaivers, "-F", "filelist.f",
