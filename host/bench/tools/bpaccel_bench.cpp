@@ -78,8 +78,8 @@ std::vector<bpaccel::DeviceProfile> makeProfiles(const ProfileOptions& o) {
   return profiles;
 }
 
-// The results of `run`, written to `jsonPath`; none, with the failure on
-// stderr, when an exact method's answer was wrong.
+// The results of `run`, written to `jsonPath` unless it is empty; none, with
+// the failure on stderr, when an exact method's answer was wrong.
 std::optional<nlohmann::json> validatedRun(const std::function<nlohmann::json()>& run, const std::string& jsonPath) {
   nlohmann::json results;
   try {
@@ -88,10 +88,16 @@ std::optional<nlohmann::json> validatedRun(const std::function<nlohmann::json()>
     fmt::print(stderr, "bench: VALIDATION FAILED: {}\n", e.what());
     return std::nullopt;
   }
+  if (jsonPath.empty()) return results;
   const std::filesystem::path path(jsonPath);
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
   std::ofstream(path) << results.dump(2) << "\n";
   return results;
+}
+
+// Where the results went, for the run's last line.
+std::string resultsWhere(const std::string& jsonPath) {
+  return jsonPath.empty() ? "not written (no --json)" : jsonPath;
 }
 
 int runBench(const bpaccel::BenchConfig& config, bpaccel::LineUpConfig lineUp, const std::vector<std::string>& cells,
@@ -104,7 +110,7 @@ int runBench(const bpaccel::BenchConfig& config, bpaccel::LineUpConfig lineUp, c
   const auto results = validatedRun([&] { return bench.run(); }, jsonPath);
   if (!results) return 3;
   fmt::print("{}", bpaccel::Benchmark::table(*results));
-  fmt::print("\nAll frames validated. Results: {}\n", jsonPath);
+  fmt::print("\nAll frames validated. Results: {}\n", resultsWhere(jsonPath));
   for (const auto& r : (*results)["rows"])
     for (const auto& m : r["methods"])
       if (m["missing_pairs"].is_number() && m["missing_pairs"].get<std::uint64_t>() > 0)
@@ -126,7 +132,8 @@ int runWorlds(const bpaccel::BenchConfig& config, const std::string& jsonPath) {
       },
       jsonPath);
   if (!results) return 3;
-  fmt::print("{}\nEvery world of every frame validated. Results: {}\n", bpaccel::manyWorldsTable(*results), jsonPath);
+  fmt::print("{}\nEvery world of every frame validated. Results: {}\n", bpaccel::manyWorldsTable(*results),
+             resultsWhere(jsonPath));
   return 0;
 }
 
@@ -177,7 +184,7 @@ int main(int argc, char** argv) {
   bpaccel::LineUpConfig lineUp;
   lineUp.cpuThreads = std::thread::hardware_concurrency();
   std::vector<std::string> benchCells = {"none", "16", "32", "64", "128", "256"};
-  std::string benchBackend = "rtl", benchJson = "results/bench.json";
+  std::string benchBackend = "rtl", benchJson;  // `make bench` names results/bench.json
   ProfileOptions profileOptions;
   // As many cells a hand-over as the batch front end queues (its count
   // queue's depth): measured against 16 (grid 64, 8000 objects, model), the
@@ -304,7 +311,7 @@ int main(int argc, char** argv) {
   benchCmd->add_option("--max-method-seconds", bench.maxMethodSeconds,
                        "Stop a method for the rest of a row when its set-up or one frame takes longer, seconds")
       ->check(CLI::PositiveNumber)->capture_default_str();
-  benchCmd->add_option("--json", benchJson, "Where to write every figure")->capture_default_str();
+  benchCmd->add_option("--json", benchJson, "Where to write every figure (nowhere unless given)");
   addSceneOptions(benchCmd, bench.scene);
 
   bpaccel::SceneConfig sceneConfig;
@@ -330,7 +337,7 @@ int main(int argc, char** argv) {
   worlds.manyWorlds.worlds = 4096;
   worlds.manyWorlds.frames = 20;
   worlds.manyWorlds.warmup = 2;
-  std::string worldsBackend = "rtl", worldsJson = "results/many_worlds.json";
+  std::string worldsBackend = "rtl", worldsJson;
   bool worldsAccelerator = true;
   auto* worldsCmd = app.add_subcommand(
       "worlds", "The many-worlds table alone: W small worlds a frame, every world's pairs validated");
@@ -343,7 +350,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"rtl", "model"}))->capture_default_str();
   worldsCmd->add_option("--profiles", profileOptions.names, "Platforms the accelerator rows are modelled on (as run's)")
       ->check(CLI::IsMember({"ecp5-5g", "gen3x8", "custom"}))->capture_default_str();
-  worldsCmd->add_option("--json", worldsJson, "Where to write every figure")->capture_default_str();
+  worldsCmd->add_option("--json", worldsJson, "Where to write every figure (nowhere unless given)");
   addSceneOptions(worldsCmd, worlds.scene);
 
   CLI11_PARSE(app, argc, argv);

@@ -701,9 +701,11 @@ TEST(DeviceClock, TheDefaultClockIsTheFmaxOfAReportOfTheSameMAndArchitectureOnly
 
 namespace {
 
-// Runs the real bpaccel binary; returns its exit code and standard output.
-std::pair<int, std::string> runBenchCli(const std::string& args, const std::string& subcommand = "run") {
-  const std::string cmd = std::string(BPACCEL_BENCH_CLI) + " " + subcommand + " " + args + " 2>/dev/null";
+// Runs the real bpaccel binary (in folder `cwd` if one is given); returns its exit code and standard output.
+std::pair<int, std::string> runBenchCli(const std::string& args, const std::string& subcommand = "run",
+                                        const std::filesystem::path& cwd = {}) {
+  const std::string cd = cwd.empty() ? "" : "cd '" + cwd.string() + "' && ";
+  const std::string cmd = cd + std::string(BPACCEL_BENCH_CLI) + " " + subcommand + " " + args + " 2>/dev/null";
   std::string out;
   FILE* pipe = ::popen(cmd.c_str(), "r");
   std::array<char, 4096> buf{};
@@ -745,6 +747,18 @@ TEST(BenchCli, NamesTheLinkUnitAndListsSkippedMethodsInTableAndJson) {
   EXPECT_EQ(profiles, (std::set<std::string>{"ecp5-5g", "gen3x8"}));
   EXPECT_EQ(j["configuration"]["profiles"].size(), 2u);
   std::filesystem::remove(json);
+}
+
+TEST(BenchCli, WritesNoResultsFileUnlessToldWhere) {
+  // A trial run must not overwrite the committed results/bench.json of the folder it runs in.
+  const auto dir = std::filesystem::temp_directory_path() / ("bpaccel-nojson-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto [code, table] = runBenchCli("--objects 40 --frames 1 --warmup 0 --no-accelerator --cell-sizes 8 "
+                                         "--many-worlds 0 --whole-step-objects 0 --query-objects none", "run", dir);
+  EXPECT_EQ(code, 0) << table;
+  EXPECT_NE(table.find("All frames validated. Results: not written (no --json)"), std::string::npos) << table;
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+  std::filesystem::remove_all(dir);
 }
 
 TEST(BenchCli, QueryObjectsNoneRunsNoQueryTableAndRefusesWhatIsNotACount) {
