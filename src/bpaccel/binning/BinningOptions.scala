@@ -37,10 +37,8 @@ final case class BinningOptions(
 }
 
 object BinningOptions {
-  /** "ax,ay,az" (or "axbxc"): the groups' bits per axis; [[groupBitsError]] first tells whether it is one. */
-  def groupBitsOf(text: String): Seq[Int] = text.split("[x,]").map(_.trim.toInt).toSeq
-
-  def groupBitsError(text: String): Option[String] =
-    if (text.matches("""\s*-?\d{1,9}\s*([x,]\s*-?\d{1,9}\s*)*""")) None
-    else Some(s"--group-bits '$text' is not whole numbers ax,ay,az")
+  /** Reads --group-bits' "ax,ay,az" (or "axbxc"), the groups' bits per axis: text that is not whole numbers
+    * fails in the parser, as any option's does, and a count other than three fails when the parameters are built.
+    */
+  val groupBitsRead: scopt.Read[Seq[Int]] = scopt.Read.reads(_.split("[x,]").map(_.trim.toInt).toSeq)
 }

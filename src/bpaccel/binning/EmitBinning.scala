@@ -65,8 +65,7 @@ object EmitBinning {
     val d = BinningParams()
     val parser = new scopt.OptionParser[Options]("EmitBinning") {
       head("Emits the binning device's SystemVerilog, C header and JSON parameters")
-      opt[String]("group-bits").validate(v => BinningOptions.groupBitsError(v).toLeft(()))
-        .action((v, o) => o.copy(b = o.b.copy(groupBits = Some(BinningOptions.groupBitsOf(v)))))
+      opt[Seq[Int]]("group-bits")(BinningOptions.groupBitsRead).action((v, o) => o.copy(b = o.b.copy(groupBits = Some(v))))
         .text(s"ax,ay,az: 2^a groups per axis (default ${d.groupBits.mkString(",")})")
       opt[Int]("lanes-per-group").action((v, o) => o.copy(b = o.b.copy(lanesPerGroup = Some(v)))).text(s"g (default ${d.g})")
       opt[Int]("key-width").action((v, o) => o.copy(b = o.b.copy(keyWidth = Some(v)))).text(s"default ${d.keyWidth}")
